@@ -1,0 +1,354 @@
+#include "contact.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "g1.h"
+
+/* Gamma(5/2) = 3 sqrt(pi) / 4: x1^(3/2) = Gamma(5/2) D^(-1/2) x1 (MODEL.md §3). */
+#define GAMMA_5_2 1.3293403881791355
+
+/* Alexander's two-stage SDIRK: L-stable, second order, stiffly accurate.
+ * L-stability keeps the step stable however fast the dashpot relaxes, and
+ * damps rather than reflects what a long step cannot resolve. */
+#define SDIRK_GAMMA 0.29289321881345248 /* 1 - 1/sqrt(2) */
+
+/* A bound on contact onsets and separations inside one internal step; only
+ * a diverging state could reach it. */
+#define MAX_EVENTS_PER_STEP 1000
+
+void contact_default_params(contact_params *p)
+{
+    p->R = 6.35e-3;
+    p->E_i = 210e9;
+    p->nu_i = 0.3;
+    p->E_s = 2.64e9;
+    p->nu_s = 0.4;
+    p->k = 3.299e8;
+    p->c = 6080.0;
+    p->dt_max = 1e-7;
+    p->g = 0.0;
+    p->gap0 = 0.0;
+    p->law = CONTACT_LAW_G1;
+    p->g1_nodes = 0;
+    p->scene = CONTACT_SCENE_DROP;
+}
+
+double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s)
+{
+    double E_star = 1.0 / ((1.0 - nu_i * nu_i) / E_i + (1.0 - nu_s * nu_s) / E_s);
+    return 4.0 / 3.0 * E_star * sqrt(R);
+}
+
+static int reject(char *msg, size_t len, const char *name, double value, const char *rule)
+{
+    snprintf(msg, len, "%s = %.17g is invalid: %s", name, value, rule);
+    return -1;
+}
+
+static int positive(double x) { return isfinite(x) && x > 0.0; }
+static int nonnegative(double x) { return isfinite(x) && x >= 0.0; }
+static int poisson_ratio(double x) { return isfinite(x) && x > -1.0 && x <= 0.5; }
+
+int contact_check_params(const contact_params *p, char *msg, size_t len)
+{
+    if (!positive(p->R))
+        return reject(msg, len, "R", p->R, "the tip radius must be positive and finite [m]");
+    if (!positive(p->E_i))
+        return reject(msg, len, "E_i", p->E_i, "Young's modulus must be positive and finite [Pa]");
+    if (!poisson_ratio(p->nu_i))
+        return reject(msg, len, "nu_i", p->nu_i, "a Poisson ratio must lie in (-1, 0.5]");
+    if (!positive(p->E_s))
+        return reject(msg, len, "E_s", p->E_s, "Young's modulus must be positive and finite [Pa]");
+    if (!poisson_ratio(p->nu_s))
+        return reject(msg, len, "nu_s", p->nu_s, "a Poisson ratio must lie in (-1, 0.5]");
+    if (!nonnegative(p->k))
+        return reject(msg, len, "k", p->k,
+                      "the Hertz constant must be finite and >= 0 (0 derives it from R, E_i, nu_i, E_s, nu_s) [N/m^1.5]");
+    if (!positive(p->c))
+        return reject(msg, len, "c", p->c, "the dashpot constant must be positive and finite [N s/m]");
+    if (!positive(p->dt_max))
+        return reject(msg, len, "dt_max", p->dt_max, "the largest internal step must be positive and finite [s]");
+    if (!isfinite(p->g))
+        return reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
+    if (!nonnegative(p->gap0))
+        return reject(msg, len, "gap0", p->gap0, "the initial gap must be finite and >= 0 [m]");
+    if (p->law != CONTACT_LAW_G1 && p->law != CONTACT_LAW_HERTZ)
+        return reject(msg, len, "law", p->law, "1 = G1 history sum, 2 = closed-form Hertz");
+    if (p->g1_nodes < 0)
+        return reject(msg, len, "g1_nodes", p->g1_nodes,
+                      "the number of G1 intervals must be >= 0 (0 = internal steps since contact onset)");
+    if (p->scene != CONTACT_SCENE_DROP && p->scene != CONTACT_SCENE_DRIVEN)
+        return reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
+    return 0;
+}
+
+int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
+{
+    if (!isfinite(v))
+        return reject(msg, len, "v", v, "the striker velocity must be finite [m/s]");
+    if (scene == CONTACT_SCENE_DROP && !positive(m))
+        return reject(msg, len, "m", m, "the drop test's striker mass must be positive and finite [kg]");
+    if (!nonnegative(m))
+        return reject(msg, len, "m", m,
+                      "the striker mass must be finite and >= 0 (0 in the driven scene: no striker inertia) [kg]");
+    return 0;
+}
+
+void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
+{
+    memset(cm, 0, sizeof *cm);
+    cm->p = *p;
+    cm->k = p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
+    cm->s.x1 = -p->gap0;
+    cm->s.v = v0;
+    if (p->scene == CONTACT_SCENE_DROP) {
+        cm->inv_m = 1.0 / m;
+        cm->accel = p->g;
+    } else {
+        contact_drive(cm, v0, m);
+    }
+}
+
+void contact_drive(contact_model *cm, double v, double m)
+{
+    if (cm->p.scene != CONTACT_SCENE_DRIVEN)
+        return;
+    cm->s.v = v;
+    cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;
+    cm->accel = m > 0.0 ? cm->p.g : 0.0;
+}
+
+double contact_spring_stiffness(const contact_model *cm, long n_steps)
+{
+    long N;
+    if (cm->p.law == CONTACT_LAW_HERTZ)
+        return cm->k;
+    N = cm->p.g1_nodes > 0 ? cm->p.g1_nodes : n_steps;
+    return N > 0 ? cm->k * g1_line_ratio(-0.5, (double)N) : cm->k;
+}
+
+/* The root s > 0 of s^2 + beta s^3 = r (r > 0, beta >= 0): s^2 is the elastic
+ * indentation of an implicit stage. The cubic increases and is convex for
+ * s > 0, so Newton's method started above the root descends onto it
+ * monotonically; sqrt(r) and cbrt(r/beta) both bound it from above. */
+static double stage_root(double r, double beta)
+{
+    double s = sqrt(r), ds;
+    int i;
+    if (beta * s > 1.0)
+        s = cbrt(r / beta);
+    for (i = 0; i < 200; i++) {
+        ds = (s * s * (1.0 + beta * s) - r) / (s * (2.0 + 3.0 * beta * s));
+        s -= ds;
+        /* Newton squares the relative error: after a correction of 1e-9 the
+         * iterate is exact to rounding. */
+        if (!(fabs(ds) > 1e-9 * s))
+            break;
+    }
+    return s;
+}
+
+/* One implicit stage of x1' = v - F/c, v' = accel - inv_m F with
+ * F = K max(x1, 0)^(3/2):  X = xh + hg (V - F/c),  V = vh + hg (accel - inv_m F).
+ * Eliminating V leaves X + beta X^(3/2) = r, one scalar root. Returns F. */
+static double implicit_stage(const contact_model *cm, double K, double hg,
+                             double xh, double vh, double *X, double *V)
+{
+    double r = xh + hg * (vh + hg * cm->accel);
+    double F = 0.0;
+    if (r > 0.0 && K > 0.0) {
+        double s = stage_root(r, K * hg * (1.0 / cm->p.c + hg * cm->inv_m));
+        *X = s * s;
+        F = K * s * s * s;
+    } else {
+        *X = r; /* out of contact the striker moves freely */
+    }
+    *V = vh + hg * (cm->accel - cm->inv_m * F);
+    return F;
+}
+
+/* One SDIRK step of length h from *in with spring stiffness K (0: free
+ * flight, where the step is exact). Writes t, x1, x2, v, F, E_diss of *out;
+ * returns the impulse of the contact force over the step. */
+static double sdirk_step(const contact_model *cm, const contact_state *in, double h,
+                         double K, contact_state *out)
+{
+    const double hg = SDIRK_GAMMA * h, hb = (1.0 - SDIRK_GAMMA) * h;
+    const double c = cm->p.c;
+    double X1, V1, X2, V2, F1, F2, impulse;
+
+    F1 = implicit_stage(cm, K, hg, in->x1, in->v, &X1, &V1);
+    F2 = implicit_stage(cm, K, hg, in->x1 + hb * (V1 - F1 / c),
+                        in->v + hb * (cm->accel - cm->inv_m * F1), &X2, &V2);
+    impulse = hb * F1 + hg * F2;
+
+    *out = *in;
+    out->t = in->t + h;
+    out->x1 = X2;
+    out->v = V2;
+    out->F = F2;
+    /* The dashpot carries the spring's force: x2' = F/c, dissipating F x2'. */
+    out->x2 = in->x2 + impulse / c;
+    out->E_diss = in->E_diss + (hb * F1 * F1 + hg * F2 * F2) / c;
+    return impulse;
+}
+
+/* Free flight is the parabola x1 + v t + accel t^2 / 2. The time in [0, h]
+ * at which it enters the specimen, given that it has entered by h. */
+static double onset_time(double x1, double v, double a, double h)
+{
+    double A = 0.5 * a, disc, q, r1, r2, t;
+    if (x1 >= 0.0 && (v > 0.0 || (v == 0.0 && a > 0.0)))
+        return 0.0;
+    if (A == 0.0)
+        t = -x1 / v;
+    else {
+        /* Roots without cancellation; a convex parabola enters at its larger
+         * root, a concave one at its smaller. */
+        disc = v * v - 4.0 * A * x1;
+        q = -0.5 * (v + copysign(sqrt(disc > 0.0 ? disc : 0.0), v));
+        r1 = q != 0.0 ? q / A : 0.0;
+        r2 = q != 0.0 ? x1 / q : r1;
+        t = a > 0.0 ? fmax(r1, r2) : fmin(r1, r2);
+    }
+    return fmin(fmax(t, 0.0), h);
+}
+
+/* The length tau in (0, h] of a contact step from *s that ends with x1 = 0,
+ * given that the full step h ends with x1 <= 0: Illinois regula falsi on the
+ * step's end value of x1, which is continuous in tau. Returns a tau whose
+ * step ends with x1 <= 0. */
+static double separation_time(const contact_model *cm, const contact_state *s,
+                              double h, double K, double x1_end)
+{
+    contact_state trial;
+    double lo = 0.0, hi = h, flo = s->x1, fhi = x1_end;
+    int i, side = 0;
+    for (i = 0; i < 200 && fhi != 0.0 && hi - lo > 1e-15 * h; i++) {
+        double tau = (lo * fhi - hi * flo) / (fhi - flo);
+        if (!(tau > lo && tau < hi))
+            tau = 0.5 * (lo + hi);
+        sdirk_step(cm, s, tau, K, &trial);
+        if (trial.x1 > 0.0) {
+            lo = tau;
+            flo = trial.x1;
+            if (side == -1)
+                fhi *= 0.5;
+            side = -1;
+        } else {
+            hi = tau;
+            fhi = trial.x1;
+            if (side == 1)
+                flo *= 0.5;
+            side = 1;
+        }
+    }
+    return hi;
+}
+
+static void begin_contact(contact_state *s)
+{
+    s->x1 = 0.0;
+    s->F = 0.0;
+    s->n = 0;
+    s->v_onset = s->v;
+    s->t_onset = s->t;
+    s->in_contact = 1;
+}
+
+static void end_contact(contact_state *s)
+{
+    s->x1 = 0.0;
+    s->F = 0.0;
+    s->eps = s->v_onset > 0.0 ? -s->v / s->v_onset : 0.0;
+    s->t_contact = s->t - s->t_onset;
+    s->impacts++;
+    s->in_contact = 0;
+}
+
+static void accept_contact_step(contact_state *s, const contact_state *trial)
+{
+    *s = *trial;
+    s->n++;
+    if (s->F > s->F_peak)
+        s->F_peak = s->F;
+}
+
+/* One internal step of length h, split at contact onset and separation.
+ * Returns 0, or -1 when the events do not end (a diverging state). */
+static int internal_step(contact_model *cm, double h, double *impulse)
+{
+    contact_state *s = &cm->s, trial;
+    int events;
+    for (events = 0; events < MAX_EVENTS_PER_STEP; events++) {
+        double tau;
+        if (!s->in_contact) {
+            sdirk_step(cm, s, h, 0.0, &trial);
+            if (!(trial.x1 > 0.0)) {
+                *s = trial;
+                return 0;
+            }
+            tau = onset_time(s->x1, s->v, cm->accel, h);
+            sdirk_step(cm, s, tau, 0.0, &trial);
+            *s = trial;
+            begin_contact(s);
+        } else {
+            double K = contact_spring_stiffness(cm, s->n + 1);
+            double J = sdirk_step(cm, s, h, K, &trial);
+            if (trial.x1 > 0.0) {
+                accept_contact_step(s, &trial);
+                *impulse += J;
+                return 0;
+            }
+            tau = separation_time(cm, s, h, K, trial.x1);
+            *impulse += sdirk_step(cm, s, tau, K, &trial);
+            accept_contact_step(s, &trial);
+            end_contact(s);
+        }
+        h -= tau;
+    }
+    return -1;
+}
+
+static int state_is_finite(const contact_state *s)
+{
+    return isfinite(s->x1) && isfinite(s->x2) && isfinite(s->v) && isfinite(s->F)
+           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->eps);
+}
+
+double contact_advance(contact_model *cm, double H)
+{
+    const contact_state start = cm->s;
+    double steps, h, impulse = 0.0, i;
+    if (!(H > 0.0))
+        return 0.0;
+    /* Round H/dt_max up, forgiving the last few ulp so that H = n dt_max
+     * gives n steps, not n + 1 with a sliver. */
+    steps = fmax(1.0, ceil(H / cm->p.dt_max * (1.0 - 1e-12)));
+    h = H / steps;
+    for (i = 0; i < steps; i++) {
+        if (internal_step(cm, h, &impulse) != 0 || !state_is_finite(&cm->s)) {
+            cm->s = start;
+            return NAN;
+        }
+    }
+    cm->s.t = start.t + H;
+    return impulse;
+}
+
+double contact_elastic_indentation(const contact_model *cm)
+{
+    return cm->s.x1 > 0.0 ? cm->s.x1 : 0.0;
+}
+
+double contact_total_indentation(const contact_model *cm)
+{
+    return cm->s.x1 + cm->s.x2;
+}
+
+double contact_semi_integral(const contact_model *cm)
+{
+    return cm->s.F / (GAMMA_5_2 * cm->k);
+}

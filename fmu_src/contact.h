@@ -1,0 +1,98 @@
+/* The rheological contact model of MODEL.md §2 and §4: a striker pushing on a
+ * Hertz spring in series with a linear dashpot. Knows nothing of FMI; the FMU
+ * and the solver both drive it through this interface. C99, libc and libm. */
+#ifndef FRACCONTACT_CONTACT_H
+#define FRACCONTACT_CONTACT_H
+
+#include <stddef.h>
+
+enum contact_law {
+    CONTACT_LAW_G1 = 1,    /* G1 history sum of D^(-1/2) x1, times Gamma(5/2) k */
+    CONTACT_LAW_HERTZ = 2  /* closed form k x1^(3/2) */
+};
+
+enum contact_scene {
+    CONTACT_SCENE_DROP = 1,   /* the model owns a free striker */
+    CONTACT_SCENE_DRIVEN = 2  /* the caller prescribes the indentation rate */
+};
+
+typedef struct {
+    double R;            /* striker tip radius [m] */
+    double E_i, nu_i;    /* indenter Young's modulus [Pa] and Poisson ratio */
+    double E_s, nu_s;    /* specimen Young's modulus [Pa] and Poisson ratio */
+    double k;            /* Hertz constant [N/m^1.5]; 0: derive from the above */
+    double c;            /* dashpot constant [N s/m] */
+    double dt_max;       /* largest internal step [s] */
+    double g;            /* acceleration of the model's striker towards the specimen [m/s^2] */
+    double gap0;         /* gap between striker and specimen at the start [m] */
+    int law;             /* enum contact_law */
+    int g1_nodes;        /* G1 intervals N; 0: internal steps since contact onset */
+    int scene;           /* enum contact_scene */
+} contact_params;
+
+typedef struct {
+    double t;         /* time [s] */
+    double x1;        /* x - x2: the elastic (Hertz) indentation while >= 0,
+                         minus the gap to the dented surface while < 0 [m] */
+    double x2;        /* permanent indentation, the dashpot's travel [m] */
+    double v;         /* striker velocity towards the specimen [m/s] */
+    double F;         /* contact force at the end of the last internal step [N] */
+    double F_peak;    /* largest contact force so far [N] */
+    double E_diss;    /* energy dissipated by the dashpot so far [J] */
+    double eps;       /* restitution coefficient of the last finished impact */
+    double v_onset;   /* striker velocity at the onset of the current contact */
+    double t_onset;   /* time of the onset of the current (or last) contact [s] */
+    double t_contact; /* duration of the last finished impact [s] */
+    long n;           /* internal steps since the onset of the current contact */
+    long impacts;     /* finished impacts */
+    int in_contact;
+} contact_state;
+
+typedef struct {
+    contact_params p;
+    double k;         /* the Hertz constant in use (given, or derived) */
+    double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
+    double accel;     /* the striker's acceleration apart from the contact force */
+    contact_state s;
+} contact_model;
+
+/* The paper's h20 test (MODEL.md §6, DESIGN.md). */
+void contact_default_params(contact_params *p);
+
+/* k = (4/3) E* sqrt(R), 1/E* = (1 - nu_i^2)/E_i + (1 - nu_s^2)/E_s. */
+double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s);
+
+/* 0 when every parameter is usable; otherwise -1 and a message naming the
+ * first offending parameter and its value. */
+int contact_check_params(const contact_params *p, char *msg, size_t len);
+
+/* The same for the striker inputs: velocity v [m/s] and mass m [kg]. */
+int contact_check_striker(int scene, double v, double m, char *msg, size_t len);
+
+/* Starts at t = 0 with the striker at the gap gap0 moving at v0 (towards the
+ * specimen). Parameters and striker must have passed the checks above. */
+void contact_start(contact_model *cm, const contact_params *p, double v0, double m);
+
+/* Driven scene: the indentation rate v from now on; m > 0 lets the model move
+ * the striker with that inertia until the next call (a proxy striker), m = 0
+ * holds v. The drop test ignores the call: its striker is the model's own. */
+void contact_drive(contact_model *cm, double v, double m);
+
+/* Advances the model by H >= 0 in equal internal steps of at most dt_max that
+ * land exactly on t + H, locating contact onset and separation within a step.
+ * Returns the impulse of the contact force over the interval [N s]; on a
+ * numerical failure (a non-finite state) returns NaN and leaves the state at
+ * the start of the failing internal step. */
+double contact_advance(contact_model *cm, double H);
+
+/* Outputs derived from the state. */
+double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */
+double contact_total_indentation(const contact_model *cm);    /* x = x1 + x2 */
+double contact_semi_integral(const contact_model *cm);        /* the D^(-1/2) x1 used for F */
+
+/* The spring's stiffness K, its force being K x1^(3/2): k for the Hertz law,
+ * k Gamma(N+3/2)/(Gamma(N) N^(3/2)) for the G1 law on N intervals (MODEL.md §4)
+ * with N = g1_nodes, or n_steps (internal steps since onset) when that is 0. */
+double contact_spring_stiffness(const contact_model *cm, long n_steps);
+
+#endif

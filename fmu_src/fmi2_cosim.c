@@ -1,0 +1,478 @@
+/* FMI 2.0 co-simulation glue: instances, the call-sequence state machine,
+ * logging, and the translation of FMI calls onto fmu_model. It knows the
+ * standard, not the physics. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "fmu_model.h"
+#include "guid.h"
+
+/* The states of FMI 2.0 §4.2.4 that a synchronous slave can be in, as bits,
+ * so that each function names the set of states it may be called in. */
+enum {
+    INSTANTIATED = 1 << 0,
+    INITIALIZATION_MODE = 1 << 1,
+    STEP_COMPLETE = 1 << 2,
+    STEP_FAILED = 1 << 3,
+    TERMINATED = 1 << 4,
+    ERROR_STATE = 1 << 5
+};
+
+#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
+#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
+#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE)
+#define STEPPING (STEP_COMPLETE | STEP_FAILED | TERMINATED)
+
+static const char *const log_categories[] = {"logEvents", "logCalls", "logStatusWarning", "logStatusError"};
+#define N_CATEGORIES (sizeof log_categories / sizeof log_categories[0])
+
+typedef struct {
+    fmi2CallbackFunctions callbacks;
+    char *name;
+    int state;
+    int logging_on;
+    int category_on[N_CATEGORIES];
+    double start_time;
+    fmu_model fm;
+} instance;
+
+/* The logger formats its message like printf: protect any '%' we pass on. */
+static void send_log(const instance *in, fmi2Status status, const char *category, const char *message)
+{
+    char escaped[1024];
+    size_t i = 0;
+    for (; *message && i + 2 < sizeof escaped; message++) {
+        if (*message == '%')
+            escaped[i++] = '%';
+        escaped[i++] = *message;
+    }
+    escaped[i] = '\0';
+    if (in->callbacks.logger)
+        in->callbacks.logger(in->callbacks.componentEnvironment, in->name, status, category, escaped);
+}
+
+static int category_index(const char *category)
+{
+    size_t i;
+    for (i = 0; i < N_CATEGORIES; i++)
+        if (strcmp(category, log_categories[i]) == 0)
+            return (int)i;
+    return -1;
+}
+
+/* Errors and warnings always reach the user; the other categories only when
+ * the master switched them on. */
+static void log_message(instance *in, fmi2Status status, const char *category, const char *message)
+{
+    int i = category_index(category);
+    if (status == fmi2Error || status == fmi2Warning || (in->logging_on && i >= 0 && in->category_on[i]))
+        send_log(in, status, category, message);
+}
+
+static void report_from_model(void *env, fm_status status, const char *category, const char *message)
+{
+    log_message((instance *)env, (fmi2Status)status, category, message);
+}
+
+static fmi2Status fail(instance *in, const char *message)
+{
+    log_message(in, fmi2Error, "logStatusError", message);
+    return fmi2Error;
+}
+
+/* Whether function `name` may be called now; logs the call when asked to. */
+static int allowed(instance *in, int states, const char *name)
+{
+    char message[160];
+    if (!in)
+        return 0;
+    if (!(in->state & states)) {
+        snprintf(message, sizeof message, "%s: illegal call sequence (not allowed in the current state)", name);
+        fail(in, message);
+        return 0;
+    }
+    log_message(in, fmi2OK, "logCalls", name);
+    return 1;
+}
+
+#define REQUIRE(states, name) \
+    if (!allowed(in, (states), (name))) \
+        return fmi2Error
+
+static int null_arrays(instance *in, size_t n, const void *a, const void *b, const char *name)
+{
+    char message[160];
+    if (n > 0 && (!a || !b)) {
+        snprintf(message, sizeof message, "%s: a NULL array with nvr = %lu", name, (unsigned long)n);
+        fail(in, message);
+        return 1;
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- instances */
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn)
+{
+    instance probe, *in;
+    (void)fmuResourceLocation;
+    (void)visible;
+    if (!functions)
+        return NULL;
+    memset(&probe, 0, sizeof probe);
+    probe.callbacks = *functions;
+    probe.name = (char *)(instanceName ? instanceName : "fraccontact");
+    if (!instanceName || !*instanceName) {
+        fail(&probe, "fmi2Instantiate: instanceName must be a non-empty string");
+        return NULL;
+    }
+    if (fmuType != fmi2CoSimulation) {
+        fail(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, FRACCONTACT_GUID) != 0) {
+        fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FRACCONTACT_GUID ")");
+        return NULL;
+    }
+    in = calloc(1, sizeof *in);
+    if (in)
+        in->name = malloc(strlen(instanceName) + 1);
+    if (!in || !in->name) {
+        free(in);
+        fail(&probe, "fmi2Instantiate: out of memory");
+        return NULL;
+    }
+    strcpy(in->name, instanceName);
+    in->callbacks = *functions;
+    in->logging_on = loggingOn != fmi2False;
+    memset(in->category_on, 1, sizeof in->category_on);
+    in->state = INSTANTIATED;
+    in->fm.report = report_from_model;
+    in->fm.report_env = in;
+    fm_reset(&in->fm);
+    return in;
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    instance *in = c;
+    if (!in)
+        return;
+    free(in->name);
+    free(in);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    instance *in = c;
+    size_t i;
+    char message[200];
+    REQUIRE(ANY_STATE, "fmi2SetDebugLogging");
+    if (null_arrays(in, nCategories, categories, categories, "fmi2SetDebugLogging"))
+        return fmi2Error;
+    for (i = 0; i < nCategories; i++)
+        if (!categories[i] || category_index(categories[i]) < 0) {
+            snprintf(message, sizeof message, "fmi2SetDebugLogging: unknown log category \"%.60s\"",
+                     categories[i] ? categories[i] : "(null)");
+            return fail(in, message);
+        }
+    in->logging_on = loggingOn != fmi2False;
+    if (nCategories == 0)
+        memset(in->category_on, 1, sizeof in->category_on);
+    else {
+        memset(in->category_on, 0, sizeof in->category_on);
+        for (i = 0; i < nCategories; i++)
+            in->category_on[category_index(categories[i])] = 1;
+    }
+    return fmi2OK;
+}
+
+/* ------------------------------------------------------------ initialization */
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    instance *in = c;
+    char message[160];
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
+    REQUIRE(INSTANTIATED, "fmi2SetupExperiment");
+    if (!isfinite(startTime)) {
+        snprintf(message, sizeof message, "fmi2SetupExperiment: startTime = %g must be finite", startTime);
+        return fail(in, message);
+    }
+    in->start_time = startTime;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    instance *in = c;
+    REQUIRE(INSTANTIATED, "fmi2EnterInitializationMode");
+    in->state = INITIALIZATION_MODE;
+    return fmi2OK;
+}
+
+/* A rejected start leaves the instance in initialization mode, so that the
+ * master can correct the value and try again. */
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    instance *in = c;
+    REQUIRE(INITIALIZATION_MODE, "fmi2ExitInitializationMode");
+    if (fm_start(&in->fm, in->start_time) != FM_OK)
+        return fmi2Error;
+    in->state = STEP_COMPLETE;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component c)
+{
+    instance *in = c;
+    REQUIRE(STEP_COMPLETE | STEP_FAILED, "fmi2Terminate");
+    in->state = TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    instance *in = c;
+    REQUIRE(ANY_STATE, "fmi2Reset");
+    fm_reset(&in->fm);
+    in->start_time = 0.0;
+    in->state = INSTANTIATED;
+    return fmi2OK;
+}
+
+/* ------------------------------------------------------- getters and setters */
+
+#define GET_LOOP(fn, get, T)                                                  \
+    fmi2Status fn(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, \
+                  T value[])                                                  \
+    {                                                                         \
+        instance *in = c;                                                     \
+        size_t i;                                                             \
+        REQUIRE(AFTER_INIT_ENTERED, #fn);                                     \
+        if (null_arrays(in, nvr, vr, value, #fn))                             \
+            return fmi2Error;                                                 \
+        for (i = 0; i < nvr; i++)                                             \
+            if (get(&in->fm, vr[i], &value[i]) != FM_OK)                      \
+                return fmi2Error;                                             \
+        return fmi2OK;                                                        \
+    }
+
+#define SET_LOOP(fn, set, T)                                                  \
+    fmi2Status fn(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, \
+                  const T value[])                                            \
+    {                                                                         \
+        instance *in = c;                                                     \
+        size_t i;                                                             \
+        REQUIRE(SETTABLE, #fn);                                               \
+        if (null_arrays(in, nvr, vr, value, #fn))                             \
+            return fmi2Error;                                                 \
+        for (i = 0; i < nvr; i++)                                             \
+            if (set(&in->fm, vr[i], value[i]) != FM_OK)                       \
+                return fmi2Error;                                             \
+        return fmi2OK;                                                        \
+    }
+
+static fm_status get_boolean(fmu_model *fm, unsigned vr, fmi2Boolean *value)
+{
+    int b;
+    fm_status status = fm_get_boolean(fm, vr, &b);
+    *value = b ? fmi2True : fmi2False;
+    return status;
+}
+
+static fm_status set_boolean(fmu_model *fm, unsigned vr, fmi2Boolean value)
+{
+    return fm_set_boolean(fm, vr, value != fmi2False);
+}
+
+/* This FMU has no String variable: every reference is an error. */
+static fm_status no_string(fmu_model *fm, unsigned vr, fmi2String value)
+{
+    char message[120];
+    (void)value;
+    snprintf(message, sizeof message, "value reference %u is not a String variable of this FMU (it has none)", vr);
+    fm->report(fm->report_env, FM_ERROR, "logStatusError", message);
+    return FM_ERROR;
+}
+
+static fm_status get_no_string(fmu_model *fm, unsigned vr, fmi2String *value)
+{
+    *value = NULL;
+    return no_string(fm, vr, NULL);
+}
+
+GET_LOOP(fmi2GetReal, fm_get_real, fmi2Real)
+GET_LOOP(fmi2GetInteger, fm_get_integer, fmi2Integer)
+GET_LOOP(fmi2GetBoolean, get_boolean, fmi2Boolean)
+GET_LOOP(fmi2GetString, get_no_string, fmi2String)
+SET_LOOP(fmi2SetReal, fm_set_real, fmi2Real)
+SET_LOOP(fmi2SetInteger, fm_set_integer, fmi2Integer)
+SET_LOOP(fmi2SetBoolean, set_boolean, fmi2Boolean)
+SET_LOOP(fmi2SetString, no_string, fmi2String)
+
+/* --------------------------------------------------------------- stepping */
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                      fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    instance *in = c;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    REQUIRE(STEP_COMPLETE, "fmi2DoStep");
+    return fm_do_step(&in->fm, currentCommunicationPoint, communicationStepSize) == FM_OK ? fmi2OK : fmi2Error;
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    instance *in = c;
+    REQUIRE(0, "fmi2CancelStep"); /* steps are synchronous: never in progress */
+    return fmi2Error;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+{
+    instance *in = c;
+    (void)s;
+    (void)value;
+    REQUIRE(STEPPING, "fmi2GetStatus");
+    return fmi2Discard; /* no asynchronous step, so no pending status */
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
+{
+    instance *in = c;
+    REQUIRE(STEPPING, "fmi2GetRealStatus");
+    if (s != fmi2LastSuccessfulTime || !value)
+        return fmi2Discard;
+    *value = in->fm.model.s.t;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
+{
+    instance *in = c;
+    (void)s;
+    (void)value;
+    REQUIRE(STEPPING, "fmi2GetIntegerStatus");
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    instance *in = c;
+    REQUIRE(STEPPING, "fmi2GetBooleanStatus");
+    if (s != fmi2Terminated || !value)
+        return fmi2Discard;
+    *value = fmi2False; /* the slave never asks to end the simulation */
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
+{
+    instance *in = c;
+    (void)s;
+    (void)value;
+    REQUIRE(STEPPING, "fmi2GetStringStatus");
+    return fmi2Discard;
+}
+
+/* ------------------------------------- capabilities this FMU does not declare */
+
+static fmi2Status unsupported(instance *in, int states, const char *name, const char *flag)
+{
+    char message[200];
+    if (!allowed(in, states, name))
+        return fmi2Error;
+    snprintf(message, sizeof message, "%s is not supported (modelDescription.xml: %s=\"false\")", name, flag);
+    return fail(in, message);
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    (void)FMUstate;
+    return unsupported(c, ANY_STATE, "fmi2GetFMUstate", "canGetAndSetFMUstate");
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    (void)FMUstate;
+    return unsupported(c, ANY_STATE, "fmi2SetFMUstate", "canGetAndSetFMUstate");
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    (void)FMUstate;
+    return unsupported(c, ANY_STATE, "fmi2FreeFMUstate", "canGetAndSetFMUstate");
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+{
+    (void)FMUstate;
+    (void)size;
+    return unsupported(c, ANY_STATE, "fmi2SerializedFMUstateSize", "canSerializeFMUstate");
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
+                                 size_t size)
+{
+    (void)FMUstate;
+    (void)serializedState;
+    (void)size;
+    return unsupported(c, ANY_STATE, "fmi2SerializeFMUstate", "canSerializeFMUstate");
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
+{
+    (void)serializedState;
+    (void)size;
+    (void)FMUstate;
+    return unsupported(c, ANY_STATE, "fmi2DeSerializeFMUstate", "canSerializeFMUstate");
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[],
+                                        size_t nKnown, const fmi2Real dvKnown[], fmi2Real dvUnknown[])
+{
+    (void)vUnknown_ref;
+    (void)nUnknown;
+    (void)vKnown_ref;
+    (void)nKnown;
+    (void)dvKnown;
+    (void)dvUnknown;
+    return unsupported(c, AFTER_INIT_ENTERED, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative");
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+{
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    return unsupported(c, SETTABLE, "fmi2SetRealInputDerivatives", "canInterpolateInputs");
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[])
+{
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    return unsupported(c, STEPPING | ERROR_STATE, "fmi2GetRealOutputDerivatives",
+                       "maxOutputDerivativeOrder");
+}

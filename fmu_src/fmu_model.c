@@ -1,0 +1,263 @@
+#include "fmu_model.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+typedef enum { REAL, INTEGER, BOOLEAN } var_type;
+typedef enum { PARAMETER, INPUT, OUTPUT } var_causality;
+
+typedef struct {
+    unsigned vr;
+    const char *name;
+    var_type type;
+    var_causality causality;
+    size_t offset; /* of the stored value in fmu_model (parameters, inputs) */
+} variable;
+
+#define PARAM(field) offsetof(fmu_model, params.field)
+
+static const variable variables[] = {
+    {VR_v, "v", REAL, INPUT, offsetof(fmu_model, v)},
+    {VR_m, "m", REAL, INPUT, offsetof(fmu_model, m)},
+    {VR_R, "R", REAL, PARAMETER, PARAM(R)},
+    {VR_E_i, "E_i", REAL, PARAMETER, PARAM(E_i)},
+    {VR_nu_i, "nu_i", REAL, PARAMETER, PARAM(nu_i)},
+    {VR_E_s, "E_s", REAL, PARAMETER, PARAM(E_s)},
+    {VR_nu_s, "nu_s", REAL, PARAMETER, PARAM(nu_s)},
+    {VR_k, "k", REAL, PARAMETER, PARAM(k)},
+    {VR_c, "c", REAL, PARAMETER, PARAM(c)},
+    {VR_dt_max, "dt_max", REAL, PARAMETER, PARAM(dt_max)},
+    {VR_g, "g", REAL, PARAMETER, PARAM(g)},
+    {VR_gap0, "gap0", REAL, PARAMETER, PARAM(gap0)},
+    {VR_F, "F", REAL, OUTPUT, 0},
+    {VR_F_avg, "F_avg", REAL, OUTPUT, 0},
+    {VR_F_peak, "F_peak", REAL, OUTPUT, 0},
+    {VR_x, "x", REAL, OUTPUT, 0},
+    {VR_x1, "x1", REAL, OUTPUT, 0},
+    {VR_x2, "x2", REAL, OUTPUT, 0},
+    {VR_v_striker, "v_striker", REAL, OUTPUT, 0},
+    {VR_E_diss, "E_diss", REAL, OUTPUT, 0},
+    {VR_eps, "eps", REAL, OUTPUT, 0},
+    {VR_semi_integral, "semi_integral", REAL, OUTPUT, 0},
+    {VR_law, "law", INTEGER, PARAMETER, PARAM(law)},
+    {VR_g1_nodes, "g1_nodes", INTEGER, PARAMETER, PARAM(g1_nodes)},
+    {VR_scene, "scene", INTEGER, PARAMETER, PARAM(scene)},
+    {VR_contact, "contact", BOOLEAN, OUTPUT, 0},
+};
+
+static const char *const type_names[] = {"Real", "Integer", "Boolean"};
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static fm_status report(fmu_model *fm, fm_status status, const char *category, const char *fmt, ...)
+{
+    char message[512];
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(message, sizeof message, fmt, args);
+    va_end(args);
+    if (fm->report)
+        fm->report(fm->report_env, status, category, message);
+    return status;
+}
+
+/* The variable of that value reference and type, or NULL after an error report. */
+static const variable *find(fmu_model *fm, unsigned vr, var_type type)
+{
+    size_t i;
+    for (i = 0; i < sizeof variables / sizeof variables[0]; i++)
+        if (variables[i].vr == vr && variables[i].type == type)
+            return &variables[i];
+    report(fm, FM_ERROR, "logStatusError", "value reference %u is not a %s variable of this FMU",
+           vr, type_names[type]);
+    return NULL;
+}
+
+/* Whether the variable may be set now; reports why not. */
+static const variable *settable(fmu_model *fm, unsigned vr, var_type type)
+{
+    const variable *var = find(fm, vr, type);
+    if (!var)
+        return NULL;
+    if (var->causality == OUTPUT) {
+        report(fm, FM_ERROR, "logStatusError", "%s is an output; it cannot be set", var->name);
+        return NULL;
+    }
+    if (var->causality == PARAMETER && fm->started) {
+        report(fm, FM_ERROR, "logStatusError",
+               "%s is a fixed parameter; it can be set only before fmi2ExitInitializationMode", var->name);
+        return NULL;
+    }
+    return var;
+}
+
+/* Applies a parameter change only if the parameters stay valid. */
+static fm_status set_parameter(fmu_model *fm, const variable *var, const void *value, size_t size)
+{
+    fmu_model trial = *fm;
+    char why[256];
+    memcpy((char *)&trial + var->offset, value, size);
+    if (contact_check_params(&trial.params, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    memcpy((char *)fm + var->offset, value, size);
+    return FM_OK;
+}
+
+/* Before initialization ends the outputs show the state the model would
+ * start from with the values set so far. */
+static void preview_start(fmu_model *fm)
+{
+    char why[256];
+    if (fm->started)
+        return;
+    if (contact_check_params(&fm->params, why, sizeof why) == 0
+        && contact_check_striker(CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0)
+        /* The mass only scales the dynamics, which a preview does not run. */
+        contact_start(&fm->model, &fm->params, fm->v, fm->m > 0.0 ? fm->m : 1.0);
+}
+
+void fm_reset(fmu_model *fm)
+{
+    fm_report r = fm->report;
+    void *env = fm->report_env;
+    memset(fm, 0, sizeof *fm);
+    fm->report = r;
+    fm->report_env = env;
+    contact_default_params(&fm->params);
+    fm->v = 0.626418; /* sqrt(2 g h) for the paper's 20 mm drop */
+    fm->m = 0.7437;
+    preview_start(fm);
+}
+
+fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
+{
+    const variable *var = settable(fm, vr, REAL);
+    char why[256];
+    if (!var)
+        return FM_ERROR;
+    if (var->causality == PARAMETER)
+        return set_parameter(fm, var, &value, sizeof value);
+    /* Inputs: the scene-dependent rule (m > 0 in the drop test) waits for
+     * fm_start, since the scene may still change. */
+    if (contact_check_striker(CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
+                              vr == VR_m ? value : fm->m, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    *(double *)((char *)fm + var->offset) = value;
+    return FM_OK;
+}
+
+static double real_output(const fmu_model *fm, unsigned vr)
+{
+    const contact_model *cm = &fm->model;
+    switch (vr) {
+    case VR_F: return cm->s.F;
+    case VR_F_avg: return fm->F_avg;
+    case VR_F_peak: return cm->s.F_peak;
+    case VR_x: return contact_total_indentation(cm);
+    case VR_x1: return contact_elastic_indentation(cm);
+    case VR_x2: return cm->s.x2;
+    case VR_v_striker: return cm->s.v;
+    case VR_E_diss: return cm->s.E_diss;
+    case VR_eps: return cm->s.eps;
+    case VR_semi_integral: return contact_semi_integral(cm);
+    default: return 0.0;
+    }
+}
+
+fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
+{
+    const variable *var = find(fm, vr, REAL);
+    if (!var)
+        return FM_ERROR;
+    preview_start(fm);
+    *value = var->causality == OUTPUT ? real_output(fm, vr) : *(const double *)((const char *)fm + var->offset);
+    return FM_OK;
+}
+
+fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
+{
+    const variable *var = settable(fm, vr, INTEGER);
+    return var ? set_parameter(fm, var, &value, sizeof value) : FM_ERROR;
+}
+
+fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
+{
+    const variable *var = find(fm, vr, INTEGER);
+    if (!var)
+        return FM_ERROR;
+    *value = *(const int *)((const char *)fm + var->offset);
+    return FM_OK;
+}
+
+fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
+{
+    (void)value;
+    return settable(fm, vr, BOOLEAN) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
+{
+    if (!find(fm, vr, BOOLEAN))
+        return FM_ERROR;
+    preview_start(fm);
+    *value = fm->model.s.in_contact;
+    return FM_OK;
+}
+
+fm_status fm_start(fmu_model *fm, double t0)
+{
+    char why[256];
+    if (contact_check_params(&fm->params, why, sizeof why) != 0
+        || contact_check_striker(fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    contact_start(&fm->model, &fm->params, fm->v, fm->m);
+    fm->model.s.t = t0;
+    fm->F_avg = 0.0;
+    fm->started = 1;
+    return FM_OK;
+}
+
+static void report_events(fmu_model *fm, const contact_state *before)
+{
+    const contact_state *s = &fm->model.s;
+    if (s->impacts != before->impacts)
+        report(fm, FM_OK, "logEvents", "impact %ld ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N",
+               s->impacts, s->t, s->eps, s->x2, s->F_peak);
+    if (s->in_contact && (!before->in_contact || s->impacts != before->impacts))
+        report(fm, FM_OK, "logEvents", "contact began in (%.9g, %.9g] s at %.6g m/s",
+               before->t, s->t, s->v_onset);
+}
+
+fm_status fm_do_step(fmu_model *fm, double t, double H)
+{
+    contact_model *cm = &fm->model;
+    contact_state before;
+    double impulse;
+    if (!isfinite(t) || !isfinite(H) || H < 0.0)
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2DoStep: currentCommunicationPoint = %.17g, communicationStepSize = %.17g: "
+                      "both must be finite and the step size >= 0", t, H);
+    /* Masters accumulate time with rounding: a mismatch below a millionth
+     * of the step is theirs, and their time wins. */
+    if (fabs(t - cm->s.t) > 1e-6 * H + 1e-12 * fabs(t))
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
+                      t, cm->s.t);
+    cm->s.t = t;
+    if (H == 0.0)
+        return FM_OK;
+    contact_drive(cm, fm->v, fm->m);
+    before = cm->s;
+    impulse = contact_advance(cm, H);
+    if (isnan(impulse))
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2DoStep: the state became non-finite in [%.17g, %.17g] s; "
+                      "it is kept at the start of the step", t, t + H);
+    fm->F_avg = impulse / H;
+    report_events(fm, &before);
+    return FM_OK;
+}

@@ -1,0 +1,235 @@
+/* The FMI 2.0 glue called directly from C, as a master would (and as the
+ * sanitizer build can instrument end to end): call sequence, bad input,
+ * independent instances, reset. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "fmi2Functions.h"
+#include "fmu_model.h" /* the value references */
+#include "guid.h"
+
+static char last_message[1024];
+static fmi2Status last_status;
+static int messages;
+
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
+                   fmi2String category, fmi2String message, ...)
+{
+    va_list args;
+    (void)env;
+    (void)name;
+    (void)category;
+    va_start(args, message);
+    vsnprintf(last_message, sizeof last_message, message, args);
+    va_end(args);
+    last_status = status;
+    messages++;
+}
+
+static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+
+static fmi2Component instantiate(const char *name)
+{
+    return fmi2Instantiate(name, fmi2CoSimulation, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+}
+
+static double get(fmi2Component c, fmi2ValueReference vr)
+{
+    double value = -1.0;
+    CHECK(fmi2GetReal(c, &vr, 1, &value) == fmi2OK, "get vr %u: %s", vr, last_message);
+    return value;
+}
+
+/* The status is an error and the log names what it must. */
+static void expect_error(fmi2Status status, const char *a, const char *b, const char *what)
+{
+    CHECK(status == fmi2Error, "%s: status %d", what, (int)status);
+    CHECK(last_status == fmi2Error && strstr(last_message, a) && (!b || strstr(last_message, b)),
+          "%s: log \"%s\" should name \"%s\"%s%s", what, last_message, a, b ? " and " : "", b ? b : "");
+}
+
+static void test_instantiate(void)
+{
+    fmi2Component c;
+    c = fmi2Instantiate("x", fmi2CoSimulation, "{wrong}", "", &callbacks, fmi2False, fmi2False);
+    CHECK(c == NULL && strstr(last_message, "fmuGUID"), "a wrong GUID is refused: %s", last_message);
+    c = fmi2Instantiate("x", fmi2ModelExchange, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+    CHECK(c == NULL && strstr(last_message, "co-simulation"), "model exchange is refused: %s", last_message);
+    c = fmi2Instantiate("", fmi2CoSimulation, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+    CHECK(c == NULL && strstr(last_message, "instanceName"), "an empty name is refused: %s", last_message);
+    CHECK(fmi2Instantiate("x", fmi2CoSimulation, FRACCONTACT_GUID, "", NULL, fmi2False, fmi2False) == NULL,
+          "no callbacks");
+    CHECK(strcmp(fmi2GetVersion(), "2.0") == 0 && strcmp(fmi2GetTypesPlatform(), "default") == 0, "version");
+    fmi2FreeInstance(NULL);
+}
+
+static void test_call_sequence(void)
+{
+    fmi2Component c = instantiate("sequence");
+    fmi2ValueReference vr = VR_F;
+    double value;
+    expect_error(fmi2DoStep(c, 0.0, 1e-5, fmi2True), "fmi2DoStep", "illegal call sequence", "doStep before init");
+    expect_error(fmi2GetReal(c, &vr, 1, &value), "fmi2GetReal", "illegal call sequence", "getReal before init");
+    expect_error(fmi2ExitInitializationMode(c), "fmi2ExitInitializationMode", NULL, "exit before enter");
+    expect_error(fmi2Terminate(c), "fmi2Terminate", NULL, "terminate before init");
+    CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter");
+    expect_error(fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), "fmi2SetupExperiment", NULL, "setup late");
+    CHECK(fmi2ExitInitializationMode(c) == fmi2OK, "exit");
+    expect_error(fmi2EnterInitializationMode(c), "fmi2EnterInitializationMode", NULL, "enter twice");
+    CHECK(fmi2DoStep(c, 0.0, 1e-5, fmi2True) == fmi2OK, "a step");
+    expect_error(fmi2DoStep(c, 0.5, 1e-5, fmi2True), "currentCommunicationPoint", "0.5", "time mismatch");
+    expect_error(fmi2DoStep(c, 1e-5, -1.0, fmi2True), "communicationStepSize", "-1", "negative step");
+    CHECK(fmi2DoStep(c, 1e-5, 1e-5, fmi2True) == fmi2OK, "the instance is still usable: %s", last_message);
+    expect_error(fmi2CancelStep(c), "fmi2CancelStep", NULL, "cancel without a pending step");
+    CHECK(fmi2Terminate(c) == fmi2OK, "terminate");
+    expect_error(fmi2DoStep(c, 2e-5, 1e-5, fmi2True), "fmi2DoStep", NULL, "step after terminate");
+    CHECK(fmi2GetReal(c, &vr, 1, &value) == fmi2OK && value > 0.0, "outputs readable after terminate");
+    CHECK(fmi2Reset(c) == fmi2OK, "reset");
+    CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter after reset");
+    fmi2FreeInstance(c);
+}
+
+/* Every real parameter and input rejects NaN and infinities with a message
+ * naming it and the value, and keeps its previous value. */
+static void test_non_finite_reals(void)
+{
+    static const fmi2ValueReference vrs[] = {VR_v, VR_m, VR_R, VR_E_i, VR_nu_i, VR_E_s, VR_nu_s,
+                                             VR_k, VR_c, VR_dt_max, VR_g, VR_gap0};
+    static const char *const names[] = {"v", "m", "R", "E_i", "nu_i", "E_s", "nu_s",
+                                        "k", "c", "dt_max", "g", "gap0"};
+    const double bad[] = {NAN, INFINITY, -INFINITY};
+    const char *const shown[] = {"nan", "inf", "-inf"};
+    fmi2Component c = instantiate("non-finite");
+    size_t i, j;
+    CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter");
+    for (i = 0; i < sizeof vrs / sizeof vrs[0]; i++) {
+        double before = get(c, vrs[i]);
+        for (j = 0; j < 3; j++) {
+            char what[64];
+            snprintf(what, sizeof what, "%s = %s", names[i], shown[j]);
+            expect_error(fmi2SetReal(c, &vrs[i], 1, &bad[j]), names[i], shown[j], what);
+        }
+        CHECK(get(c, vrs[i]) == before, "%s kept its value", names[i]);
+    }
+    CHECK(fmi2ExitInitializationMode(c) == fmi2OK, "the defaults still start: %s", last_message);
+    fmi2FreeInstance(c);
+}
+
+static void test_out_of_range(void)
+{
+    struct { fmi2ValueReference vr; double value; const char *name; } reals[] = {
+        {VR_c, 0.0, "c"}, {VR_c, -1.0, "c"}, {VR_k, -1.0, "k"}, {VR_R, 0.0, "R"}, {VR_R, -1e-3, "R"},
+        {VR_dt_max, 0.0, "dt_max"}, {VR_dt_max, -1e-7, "dt_max"}, {VR_m, -1.0, "m"},
+        {VR_E_i, 0.0, "E_i"}, {VR_E_s, -2e9, "E_s"}, {VR_nu_i, 0.6, "nu_i"}, {VR_nu_s, -1.0, "nu_s"},
+        {VR_gap0, -1e-3, "gap0"}};
+    struct { fmi2ValueReference vr; int value; const char *name; } ints[] = {
+        {VR_law, 0, "law"}, {VR_law, 3, "law"}, {VR_scene, 0, "scene"}, {VR_scene, 3, "scene"},
+        {VR_g1_nodes, -1, "g1_nodes"}};
+    fmi2Component c = instantiate("range");
+    fmi2ValueReference vr;
+    size_t i;
+    for (i = 0; i < sizeof reals / sizeof reals[0]; i++)
+        expect_error(fmi2SetReal(c, &reals[i].vr, 1, &reals[i].value), reals[i].name, " = ", reals[i].name);
+    for (i = 0; i < sizeof ints / sizeof ints[0]; i++)
+        expect_error(fmi2SetInteger(c, &ints[i].vr, 1, &ints[i].value), ints[i].name, " = ", ints[i].name);
+
+    vr = VR_F;
+    expect_error(fmi2SetReal(c, &vr, 1, &reals[0].value), "F is an output", NULL, "set an output");
+    vr = 999;
+    expect_error(fmi2SetReal(c, &vr, 1, &reals[0].value), "999", "Real", "unknown real reference");
+    expect_error(fmi2SetInteger(c, &vr, 1, &ints[0].value), "999", "Integer", "unknown integer reference");
+    vr = VR_F; /* a Real's reference is no Integer */
+    expect_error(fmi2SetInteger(c, &vr, 1, &ints[0].value), "13", "Integer", "reference of the wrong type");
+    expect_error(fmi2SetReal(c, NULL, 1, &reals[0].value), "NULL", NULL, "NULL array");
+
+    /* The drop test needs a mass; the driven scene takes 0 as "no inertia". */
+    {
+        double zero = 0.0;
+        int driven = 2;
+        vr = VR_m;
+        CHECK(fmi2SetReal(c, &vr, 1, &zero) == fmi2OK, "m = 0 is accepted until the scene is known");
+        CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter");
+        expect_error(fmi2ExitInitializationMode(c), "m = 0", "drop test", "drop test without mass");
+        vr = VR_scene;
+        CHECK(fmi2SetInteger(c, &vr, 1, &driven) == fmi2OK, "scene = 2: %s", last_message);
+        CHECK(fmi2ExitInitializationMode(c) == fmi2OK, "driven with m = 0 starts: %s", last_message);
+        vr = VR_c;
+        expect_error(fmi2SetReal(c, &vr, 1, &zero), "c is a fixed parameter", NULL, "parameter after init");
+    }
+    fmi2FreeInstance(c);
+}
+
+/* Two instances stepped alternately give, bit for bit, what each gives
+ * alone: no shared state. */
+static void test_independent_instances(void)
+{
+    fmi2ValueReference vr_c = VR_c, out[] = {VR_F, VR_x2, VR_E_diss, VR_F_peak};
+    double soft = 2000.0, alone[2][4], together[2][4];
+    fmi2Component a, b;
+    int i, k;
+    for (k = 0; k < 2; k++) {
+        fmi2Component c = instantiate("alone");
+        if (k == 1)
+            fmi2SetReal(c, &vr_c, 1, &soft);
+        fmi2EnterInitializationMode(c);
+        fmi2ExitInitializationMode(c);
+        for (i = 0; i < 60; i++)
+            fmi2DoStep(c, i * 1e-5, 1e-5, fmi2True);
+        fmi2GetReal(c, out, 4, alone[k]);
+        fmi2FreeInstance(c);
+    }
+    a = instantiate("a");
+    b = instantiate("b");
+    fmi2SetReal(b, &vr_c, 1, &soft);
+    fmi2EnterInitializationMode(a);
+    fmi2EnterInitializationMode(b);
+    fmi2ExitInitializationMode(a);
+    fmi2ExitInitializationMode(b);
+    for (i = 0; i < 60; i++) {
+        fmi2DoStep(a, i * 1e-5, 1e-5, fmi2True);
+        fmi2DoStep(b, i * 1e-5, 1e-5, fmi2True);
+    }
+    fmi2GetReal(a, out, 4, together[0]);
+    fmi2GetReal(b, out, 4, together[1]);
+    CHECK(memcmp(alone, together, sizeof alone) == 0, "interleaved instances differ from lone ones");
+    CHECK(alone[0][0] != alone[1][0], "the two instances should differ (c = 6080 vs 2000)");
+    /* Reset gives the same run again. */
+    fmi2Reset(a);
+    fmi2EnterInitializationMode(a);
+    fmi2ExitInitializationMode(a);
+    for (i = 0; i < 60; i++)
+        fmi2DoStep(a, i * 1e-5, 1e-5, fmi2True);
+    fmi2GetReal(a, out, 4, together[0]);
+    CHECK(memcmp(alone[0], together[0], sizeof alone[0]) == 0, "a reset instance repeats its run");
+    fmi2FreeInstance(a);
+    fmi2FreeInstance(b);
+}
+
+static void test_logging(void)
+{
+    fmi2Component c = instantiate("logging");
+    const char *events[] = {"logEvents"}, *unknown[] = {"logEverything"};
+    int before;
+    expect_error(fmi2SetDebugLogging(c, fmi2True, 1, unknown), "logEverything", NULL, "unknown category");
+    CHECK(fmi2SetDebugLogging(c, fmi2True, 1, events) == fmi2OK, "enable logEvents");
+    fmi2EnterInitializationMode(c);
+    fmi2ExitInitializationMode(c);
+    before = messages;
+    fmi2DoStep(c, 0.0, 3e-3, fmi2True);
+    CHECK(messages > before && strstr(last_message, "impact 1 ended"), "event log: %s", last_message);
+    fmi2FreeInstance(c);
+}
+
+int main(void)
+{
+    test_instantiate();
+    test_call_sequence();
+    test_non_finite_reals();
+    test_out_of_range();
+    test_independent_instances();
+    test_logging();
+    return check_summary("test_fmi2");
+}
