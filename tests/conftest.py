@@ -1,0 +1,48 @@
+"""Fixtures: the FMU under test (FRACCONTACT_FMU, else build/fraccontact.fmu)."""
+
+import os
+import pathlib
+import shutil
+
+import pytest
+from fmpy import extract, read_model_description
+
+from fmu_driver import Slave
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+FMU = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
+
+
+@pytest.fixture(scope="session")
+def fmu_path():
+    if not FMU.exists():
+        pytest.fail(f"{FMU} does not exist: build first (scripts/build)")
+    return FMU
+
+
+@pytest.fixture(scope="session")
+def model_description(fmu_path):
+    return read_model_description(str(fmu_path))
+
+
+@pytest.fixture(scope="session")
+def unzipped(fmu_path):
+    folder = extract(str(fmu_path))
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture
+def slave(model_description, unzipped):
+    """slave(start=True, **values) -> an instance with those values set
+    (and initialized unless start=False); freed after the test."""
+    made = []
+
+    def make(start=True, **values):
+        s = Slave(model_description, unzipped, start=start, **values)
+        made.append(s)
+        return s
+
+    yield make
+    for s in made:
+        s.fmu.freeInstance()

@@ -1,0 +1,204 @@
+"""The force through the FMU against what is known independently of it:
+closed forms (MODEL.md §2-§4) and a high-accuracy solve of the same ODE
+with scipy."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from fmu_driver import C, K, M, run_impact
+
+GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
+
+
+def g1_line_ratio(N):
+    """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), MODEL.md §4, by Python's lgamma."""
+    return math.exp(math.lgamma(N + 1.5) - math.lgamma(N) - 1.5 * math.log(N))
+
+
+def hertz_k(R, E_i, nu_i, E_s, nu_s):
+    return 4.0 / 3.0 * math.sqrt(R) / ((1 - nu_i ** 2) / E_i + (1 - nu_s ** 2) / E_s)
+
+
+def reference_drop(k, c, m, v0):
+    """The drop test's ODE (MODEL.md §2) by scipy's DOP853 at rtol 1e-13:
+    x1' = v - F/c, v' = -F/m, x2' = F/c, E_diss' = F^2/c, F = k x1^(3/2);
+    the peak force where x1' = 0, separation where x1 returns to 0."""
+    def rhs(t, y):
+        F = k * max(y[0], 0.0) ** 1.5
+        return [y[1] - F / c, -F / m, F / c, F * F / c]
+
+    def separation(t, y):
+        return y[0]
+    separation.terminal, separation.direction = True, -1
+
+    def elastic_rate(t, y):
+        return y[1] - k * max(y[0], 0.0) ** 1.5 / c
+    elastic_rate.direction = -1
+
+    # x1 ~ v0 t at first: start just after contact so the separation event
+    # does not see the starting zero; the skipped interval changes nothing
+    # measurable (F there is ~1e-12 N).
+    t0 = 1e-12
+    sol = solve_ivp(rhs, (t0, 1.0), [v0 * t0, v0, 0.0, 0.0], method="DOP853", rtol=1e-13,
+                    atol=[1e-19, 1e-15, 1e-19, 1e-17], events=[separation, elastic_rate])
+    t_sep, y_sep = sol.t_events[0][0], sol.y_events[0][0]
+    x1_max = sol.y_events[1][0][0]
+    return dict(F_peak=k * x1_max ** 1.5, eps=-y_sep[1] / v0, t_contact=t_sep, x2=y_sep[2], E_diss=y_sep[3])
+
+
+# --- driven scene: constant rate, rigid dashpot -> x1 = v t exactly ---------
+
+def driven(slave, law, g1_nodes=0, k=K, **extra):
+    v, H = 0.5, 1e-6
+    s = slave(scene=2, m=0.0, v=v, c=1e20, law=law, g1_nodes=g1_nodes, k=k, dt_max=1e-7, **extra)
+    rows = []
+    for n in range(1, 41):
+        s.step(H)
+        rows.append((n * H, 10 * n, s.get("F"), s.get("semi_integral"), s.get("x1")))
+    return v, rows
+
+
+# x1 is a sum of up to 400 steps of v h: rounding ~1e-13 relative; the dashpot
+# (c = 1e20) moves by F t / c ~ 1e-22 m against x1 ~ 1e-5 m.
+DRIVEN_RTOL = 1e-11
+
+
+def test_driven_hertz_law_is_k_x1_to_the_3_2(slave):
+    v, rows = driven(slave, law=2)
+    for t, N, F, semi, x1 in rows:
+        assert x1 == pytest.approx(v * t, rel=DRIVEN_RTOL)
+        assert F == pytest.approx(K * (v * t) ** 1.5, rel=DRIVEN_RTOL)
+        assert semi == pytest.approx((v * t) ** 1.5 / GAMMA_5_2, rel=DRIVEN_RTOL)
+
+
+def test_driven_g1_law_has_the_straight_line_error(slave):
+    """N = internal steps since onset: 10 per communication step of 1 us."""
+    v, rows = driven(slave, law=1)
+    for t, N, F, semi, x1 in rows:
+        assert F == pytest.approx(K * (v * t) ** 1.5 * g1_line_ratio(N), rel=DRIVEN_RTOL)
+        assert semi == pytest.approx((v * t) ** 1.5 / GAMMA_5_2 * g1_line_ratio(N), rel=DRIVEN_RTOL)
+    # The first-order error of MODEL.md §4: 1 + 3/(8N) to O(N^-2).
+    t, N, F, _, _ = rows[-1]
+    assert F / (K * (v * t) ** 1.5) - 1 == pytest.approx(3 / (8 * N), rel=5 / N)
+
+
+def test_driven_g1_law_with_fixed_nodes(slave):
+    v, rows = driven(slave, law=1, g1_nodes=7)
+    for t, N, F, semi, x1 in rows:
+        assert F == pytest.approx(K * (v * t) ** 1.5 * g1_line_ratio(7), rel=DRIVEN_RTOL)
+
+
+def test_k_zero_derives_k_from_the_materials(slave):
+    materials = dict(R=6.35e-3, E_i=210e9, nu_i=0.3, E_s=2.64e9, nu_s=0.4)
+    k = hertz_k(**materials)
+    v, rows = driven(slave, law=2, k=0.0, **materials)
+    for t, N, F, semi, x1 in rows:
+        assert F == pytest.approx(k * (v * t) ** 1.5, rel=DRIVEN_RTOL)
+    # MODEL.md §6: the paper's E_s = 2.64 GPa is consistent with its k.
+    assert k == pytest.approx(K, rel=2e-3)
+
+
+# --- drop test --------------------------------------------------------------
+
+def test_elastic_limit_matches_hertz_closed_forms(slave):
+    """c -> infinity: pure Hertz impact (MODEL.md §2)."""
+    s = slave(law=2, c=1e15)
+    v0 = s.get("v")
+    x_max = (5 * M * v0 ** 2 / (4 * K)) ** 0.4
+    H, x1_max = 1e-6, 0.0
+    while s.get("eps") == 0.0:
+        s.step(H)
+        x1_max = max(x1_max, s.get("x1"))
+    r = run_impact(s)
+    # The scheme errs by ~(dt/t_c)^2 ~ 1e-8; sampling x1 every H misses its
+    # maximum by at most (pi H / t_c)^2 / 8 ~ 7e-7; the closed-form contact
+    # time's constant is given to 6 digits.
+    assert r["F_peak"] == pytest.approx(K * x_max ** 1.5, rel=1e-7)
+    assert x1_max == pytest.approx(x_max, rel=2e-6)
+    assert r["t_contact"] == pytest.approx(2.94327 * x_max / v0, rel=5e-6)
+    assert r["eps"] == pytest.approx(1.0, abs=1e-7)
+
+
+@pytest.fixture(scope="module")
+def h20_reference():
+    return reference_drop(K, C, M, math.sqrt(2 * 9.81 * 0.020))
+
+
+def test_reference_is_converged():
+    """The reference itself: Radau at the same tolerance agrees to 1e-9."""
+    a = reference_drop(K, C, M, 0.6)
+    k, c, m, v0 = K, C, M, 0.6
+
+    def rhs(t, y):
+        F = k * max(y[0], 0.0) ** 1.5
+        return [y[1] - F / c, -F / m, F / c, F * F / c]
+
+    def separation(t, y):
+        return y[0]
+    separation.terminal, separation.direction = True, -1
+    sol = solve_ivp(rhs, (1e-12, 1.0), [0.6e-12, v0, 0, 0], method="Radau", rtol=1e-12, atol=1e-20,
+                    events=[separation])
+    y = sol.y_events[0][0]
+    assert -y[1] / v0 == pytest.approx(a["eps"], rel=1e-9)
+    assert y[2] == pytest.approx(a["x2"], rel=1e-9)
+
+
+@pytest.mark.parametrize("H", [1e-5, 3.3e-6])
+def test_drop_hertz_law_matches_the_reference(slave, h20_reference, H):
+    """Law 2 at the defaults (dt_max = 1e-7): the scheme's second-order error
+    is ~(dt/t_c)^2 = 6e-9 with t_c = 1.3 ms; the issue's 1e-5 bound leaves a
+    wide margin, so we hold it to 1e-6. The communication step (1e-5, and a
+    step that is no multiple of dt_max) must not matter."""
+    s = slave(law=2, v=math.sqrt(2 * 9.81 * 0.020))
+    r = run_impact(s, H=H)
+    for key in ("F_peak", "eps", "t_contact", "x2", "E_diss"):
+        assert r[key] == pytest.approx(h20_reference[key], rel=1e-6), key
+
+
+def test_drop_momentum_identity(slave):
+    """x2_end = m v0 (1 + eps) / c holds to rounding for both laws: the scheme
+    keeps the linear invariant m v + c x2 exactly."""
+    for law in (1, 2):
+        s = slave(law=law)
+        v0 = s.get("v")
+        r = run_impact(s)
+        assert r["x2"] == pytest.approx(M * v0 * (1 + r["eps"]) / C, rel=1e-12)
+
+
+def test_drop_g1_law_with_fixed_nodes_matches_its_reference(slave):
+    """With N fixed the G1 law is Hertz with k Gamma(N+3/2)/(Gamma(N) N^1.5):
+    the same ODE, so the same reference and the same tolerance."""
+    N = 10
+    s = slave(law=1, g1_nodes=N)
+    v0 = s.get("v")
+    ref = reference_drop(K * g1_line_ratio(N), C, M, v0)
+    r = run_impact(s)
+    for key in ("F_peak", "eps", "t_contact", "x2", "E_diss"):
+        assert r[key] == pytest.approx(ref[key], rel=1e-6), key
+
+
+def test_drop_g1_law_converges_to_hertz_at_first_order(slave, h20_reference):
+    """N = steps since onset: the G1 error 3/(8N) shrinks with the step, so
+    law 1 approaches law 2 linearly in dt_max."""
+    errors = []
+    for dt in (4e-7, 2e-7, 1e-7):
+        s = slave(law=1, dt_max=dt, v=math.sqrt(2 * 9.81 * 0.020))
+        errors.append(abs(run_impact(s)["F_peak"] / h20_reference["F_peak"] - 1))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - 1) < 0.1), (errors, orders)
+
+
+def test_energy_balance_through_the_outputs(slave):
+    """1/2 m v0^2 = 1/2 m v^2 + (2/5) k x1^(5/2) + E_diss at every
+    communication point, to the scheme's O(dt^2) ~ 1e-8."""
+    s = slave(law=2)
+    v0 = s.get("v")
+    E0 = 0.5 * M * v0 ** 2
+    while s.t < 2e-3:
+        s.step(2e-5)
+        x1 = s.get("x1")
+        E = 0.5 * M * s.get("v_striker") ** 2 + 0.4 * K * x1 ** 2.5 + s.get("E_diss")
+        assert E == pytest.approx(E0, rel=1e-7)
