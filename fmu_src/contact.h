@@ -51,6 +51,7 @@ typedef struct {
 typedef struct {
     contact_params p;
     double k;         /* the Hertz constant in use (given, or derived) */
+    double inv_c;     /* 1/c */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
     contact_state s;

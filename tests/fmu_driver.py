@@ -47,6 +47,10 @@ class Slave:
         self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
 
+    def enter(self):
+        """Initialization mode: values can be set and read back."""
+        self.fmu.enterInitializationMode()
+
     def set(self, **values):
         for name, value in values.items():
             v = self.variables[name]
