@@ -34,6 +34,7 @@ void contact_default_params(contact_params *p)
     p->law = CONTACT_LAW_G1;
     p->g1_nodes = 0;
     p->scene = CONTACT_SCENE_DROP;
+    p->scheme = CONTACT_SCHEME_SDIRK2;
 }
 
 double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s)
@@ -81,13 +82,16 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
     if (!nonnegative(p->gap0))
         return reject(msg, len, "gap0", p->gap0, "the initial gap must be finite and >= 0 [m]");
-    if (p->law != CONTACT_LAW_G1 && p->law != CONTACT_LAW_HERTZ)
-        return reject(msg, len, "law", p->law, "1 = G1 history sum, 2 = closed-form Hertz");
+    if (p->law < CONTACT_LAW_G1 || p->law > CONTACT_LAW_G1_EXTRAPOLATED)
+        return reject(msg, len, "law", p->law,
+                      "1 = G1 history sum, 2 = closed-form Hertz, 3 = G1 with Richardson extrapolation");
     if (p->g1_nodes < 0)
         return reject(msg, len, "g1_nodes", p->g1_nodes,
                       "the number of G1 intervals must be >= 0 (0 = internal steps since contact onset)");
     if (p->scene != CONTACT_SCENE_DROP && p->scene != CONTACT_SCENE_DRIVEN)
         return reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
+    if (p->scheme != CONTACT_SCHEME_SDIRK2 && p->scheme != CONTACT_SCHEME_CENTRAL)
+        return reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
     return 0;
 }
 
@@ -134,7 +138,10 @@ double contact_spring_stiffness(const contact_model *cm, long n_steps)
     if (cm->p.law == CONTACT_LAW_HERTZ)
         return cm->k;
     N = cm->p.g1_nodes > 0 ? cm->p.g1_nodes : n_steps;
-    return N > 0 ? cm->k * g1_line_ratio(-0.5, (double)N) : cm->k;
+    if (N < 1)
+        return cm->k;
+    return cm->k * (cm->p.law == CONTACT_LAW_G1 ? g1_line_ratio(-0.5, (double)N)
+                                                : g1_line_ratio_extrapolated(-0.5, (double)N));
 }
 
 /* The root s > 0 of s^2 + beta s^3 = r (r > 0, beta >= 0): s^2 is the elastic
@@ -262,22 +269,21 @@ static double separation_time(const contact_model *cm, const contact_state *s,
     return hi;
 }
 
-static void begin_contact(contact_state *s)
+/* Contact begins at time t with striker velocity v. */
+static void begin_contact(contact_state *s, double t, double v)
 {
-    s->x1 = 0.0;
-    s->F = 0.0;
     s->n = 0;
-    s->v_onset = s->v;
-    s->t_onset = s->t;
+    s->v_onset = v;
+    s->t_onset = t;
     s->in_contact = 1;
 }
 
-static void end_contact(contact_state *s)
+/* Contact ends at time t with striker velocity v. */
+static void end_contact(contact_state *s, double t, double v)
 {
-    s->x1 = 0.0;
     s->F = 0.0;
-    s->eps = s->v_onset > 0.0 ? -s->v / s->v_onset : 0.0;
-    s->t_contact = s->t - s->t_onset;
+    s->eps = s->v_onset > 0.0 ? -v / s->v_onset : 0.0;
+    s->t_contact = t - s->t_onset;
     s->impacts++;
     s->in_contact = 0;
 }
@@ -290,9 +296,9 @@ static void accept_contact_step(contact_state *s, const contact_state *trial)
         s->F_peak = s->F;
 }
 
-/* One internal step of length h, split at contact onset and separation.
+/* One SDIRK step of length h, split at contact onset and separation.
  * Returns 0, or -1 when the events do not end (a diverging state). */
-static int internal_step(contact_model *cm, double h, double *impulse)
+static int sdirk_internal_step(contact_model *cm, double h, double *impulse)
 {
     contact_state *s = &cm->s, trial;
     int events;
@@ -307,7 +313,9 @@ static int internal_step(contact_model *cm, double h, double *impulse)
             tau = onset_time(s->x1, s->v, cm->accel, h);
             sdirk_step(cm, s, tau, 0.0, &trial);
             *s = trial;
-            begin_contact(s);
+            s->x1 = 0.0;
+            s->F = 0.0;
+            begin_contact(s, s->t, s->v);
         } else {
             double K = contact_spring_stiffness(cm, s->n + 1);
             double J = sdirk_step(cm, s, h, K, &trial);
@@ -319,11 +327,58 @@ static int internal_step(contact_model *cm, double h, double *impulse)
             tau = separation_time(cm, s, h, K, trial.x1);
             *impulse += sdirk_step(cm, s, tau, K, &trial);
             accept_contact_step(s, &trial);
-            end_contact(s);
+            s->x1 = 0.0;
+            end_contact(s, s->t, s->v);
         }
         h -= tau;
     }
     return -1;
+}
+
+/* The paper's explicit scheme (MODEL.md §5), kept for comparison: x'' by
+ * central differences (Stormer), the dashpot x2' = F/c by forward Euler with
+ * the force of the step's start, so it is stable only while the dashpot's
+ * relaxation lambda h < 2. Onset and separation are where x1 changes sign,
+ * their times interpolated linearly; no step is split. */
+static void central_internal_step(contact_model *cm, double h, double *impulse)
+{
+    contact_state *s = &cm->s;
+    const double x = s->x1 + s->x2, x1 = s->x1, t = s->t, F = s->F;
+    const double a = cm->accel - cm->inv_m * F;
+    double x_next, x1_next;
+    if (s->h_prev != h) /* (re)start the two-step recursion from the velocity */
+        s->x_prev = x - h * s->v + 0.5 * h * h * a;
+    x_next = cm->inv_m > 0.0 ? 2.0 * x - s->x_prev + h * h * a : x + h * s->v;
+    s->x2 += h * F * cm->inv_c;
+    s->E_diss += h * F * F * cm->inv_c;
+    *impulse += h * F;
+    x1_next = x_next - s->x2;
+    if (!s->in_contact && x1_next > 0.0)
+        begin_contact(s, t + h * (x1 < 0.0 ? x1 / (x1 - x1_next) : 0.0), s->v);
+    s->x_prev = x;
+    s->h_prev = h;
+    s->x1 = x1_next;
+    s->t = t + h;
+    if (s->in_contact) {
+        s->n++;
+        s->F = x1_next > 0.0 ? contact_spring_stiffness(cm, s->n) * x1_next * sqrt(x1_next) : 0.0;
+    }
+    if (cm->inv_m > 0.0) /* second-order velocity at the step's end */
+        s->v = (x_next - x) / h + 0.5 * h * (cm->accel - cm->inv_m * s->F);
+    if (s->F > s->F_peak)
+        s->F_peak = s->F;
+    if (s->in_contact && !(x1_next > 0.0))
+        end_contact(s, t + h * x1 / (x1 - x1_next), s->v);
+}
+
+static int internal_step(contact_model *cm, double h, double *impulse)
+{
+    cm->s.steps++;
+    if (cm->p.scheme == CONTACT_SCHEME_CENTRAL) {
+        central_internal_step(cm, h, impulse);
+        return 0;
+    }
+    return sdirk_internal_step(cm, h, impulse);
 }
 
 static int state_is_finite(const contact_state *s)

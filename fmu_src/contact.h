@@ -7,8 +7,14 @@
 #include <stddef.h>
 
 enum contact_law {
-    CONTACT_LAW_G1 = 1,    /* G1 history sum of D^(-1/2) x1, times Gamma(5/2) k */
-    CONTACT_LAW_HERTZ = 2  /* closed form k x1^(3/2) */
+    CONTACT_LAW_G1 = 1,              /* G1 history sum of D^(-1/2) x1, times Gamma(5/2) k */
+    CONTACT_LAW_HERTZ = 2,           /* closed form k x1^(3/2) */
+    CONTACT_LAW_G1_EXTRAPOLATED = 3  /* G1 with Richardson extrapolation: second order in 1/N */
+};
+
+enum contact_scheme {
+    CONTACT_SCHEME_SDIRK2 = 1,  /* L-stable implicit, second order, events located (default) */
+    CONTACT_SCHEME_CENTRAL = 2  /* the paper's explicit central differences (MODEL.md §5) */
 };
 
 enum contact_scene {
@@ -28,6 +34,7 @@ typedef struct {
     int law;             /* enum contact_law */
     int g1_nodes;        /* G1 intervals N; 0: internal steps since contact onset */
     int scene;           /* enum contact_scene */
+    int scheme;          /* enum contact_scheme */
 } contact_params;
 
 typedef struct {
@@ -44,6 +51,9 @@ typedef struct {
     double t_onset;   /* time of the onset of the current (or last) contact [s] */
     double t_contact; /* duration of the last finished impact [s] */
     long n;           /* internal steps since the onset of the current contact */
+    long steps;       /* internal steps taken */
+    double x_prev;    /* central differences: total indentation one step back, */
+    double h_prev;    /* and that step (0: not yet known) */
     long impacts;     /* finished impacts */
     int in_contact;
 } contact_state;
@@ -93,7 +103,8 @@ double contact_semi_integral(const contact_model *cm);        /* the D^(-1/2) x1
 
 /* The spring's stiffness K, its force being K x1^(3/2): k for the Hertz law,
  * k Gamma(N+3/2)/(Gamma(N) N^(3/2)) for the G1 law on N intervals (MODEL.md §4)
- * with N = g1_nodes, or n_steps (internal steps since onset) when that is 0. */
+ * with N = g1_nodes, or n_steps (internal steps since onset) when that is 0;
+ * the extrapolated G1 law replaces that ratio by g1_line_ratio_extrapolated. */
 double contact_spring_stiffness(const contact_model *cm, long n_steps);
 
 #endif

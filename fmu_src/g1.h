@@ -17,10 +17,21 @@ void g1_weights(double alpha, size_t n, double *w);
 double g1_history_sum(double alpha, const double *w, const double *f,
                       size_t n_samples, double delta);
 
+/* Richardson extrapolation of the above over the grids of spacing delta and
+ * 2 delta (n_samples - 1 must be even): 2 G1_delta - G1_2delta, which cancels
+ * G1's O(delta) error term at O(n) cost. */
+double g1_history_sum_extrapolated(double alpha, const double *w, const double *f,
+                                   size_t n_samples, double delta);
+
 /* For the identity f(xi) = xi on N >= 1 intervals of [0, x], the ratio of
  * the G1 value of D^alpha f at x to the exact value x^(1-alpha)/Gamma(2-alpha):
  *     Gamma(N + 1 - alpha) / (Gamma(N) N^(1 - alpha)) = 1 + O(1/N).
  * O(1), accurate to a few ulp for every N (no lgamma cancellation). */
 double g1_line_ratio(double alpha, double N);
+
+/* The same ratio after Richardson extrapolation over N and M = floor(N/2)
+ * intervals, (N r(N) - M r(M)) / (N - M) = 1 + O(1/N^2); r(1) for N = 1,
+ * which has no coarser grid. */
+double g1_line_ratio_extrapolated(double alpha, double N);
 
 #endif

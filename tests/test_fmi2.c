@@ -127,7 +127,7 @@ static void test_out_of_range(void)
         {VR_E_i, 0.0, "E_i"}, {VR_E_s, -2e9, "E_s"}, {VR_nu_i, 0.6, "nu_i"}, {VR_nu_s, -1.0, "nu_s"},
         {VR_gap0, -1e-3, "gap0"}};
     struct { fmi2ValueReference vr; int value; const char *name; } ints[] = {
-        {VR_law, 0, "law"}, {VR_law, 3, "law"}, {VR_scene, 0, "scene"}, {VR_scene, 3, "scene"},
+        {VR_law, 0, "law"}, {VR_law, 4, "law"}, {VR_scene, 0, "scene"}, {VR_scene, 3, "scene"},
         {VR_g1_nodes, -1, "g1_nodes"}};
     fmi2Component c = instantiate("range");
     fmi2ValueReference vr;

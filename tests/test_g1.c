@@ -52,6 +52,39 @@ static void test_power_rule_order(void)
     free(f);
 }
 
+/* Richardson extrapolation over the grids delta and 2 delta cancels G1's
+ * O(delta) term: second order, except where it leaves nothing at all
+ * (alpha = -1 on a straight line: the extrapolated sum is Simpson-exact). */
+static void test_extrapolated_order(void)
+{
+    static const double alphas[] = {-0.5, -1.0, 0.5};
+    static const double qs[] = {1.0, 2.0};
+    const size_t n_max = 25600;
+    double *w = malloc((n_max + 1) * sizeof *w), *f = malloc((n_max + 1) * sizeof *f);
+    size_t a, b, n, i;
+    for (a = 0; a < 3; a++)
+        for (b = 0; b < 2; b++) {
+            double alpha = alphas[a], q = qs[b], exact = power_rule_at_1(alpha, q), previous = 0.0;
+            g1_weights(alpha, n_max + 1, w);
+            for (n = 400; n <= n_max; n *= 2) {
+                double delta = 1.0 / (double)n, err;
+                for (i = 0; i <= n; i++)
+                    f[i] = pow((double)i * delta, q);
+                err = fabs(g1_history_sum_extrapolated(alpha, w, f, n + 1, delta) - exact);
+                if (alpha == -1.0 && q == 1.0)
+                    CHECK(err < 1e-13, "alpha -1, q 1, N %lu: error %.3g", (unsigned long)n, err);
+                else if (n > 400) {
+                    double order = log2(previous / err);
+                    CHECK(order >= 1.95 && order <= 2.05, "extrapolated, alpha %g, q %g, N %lu: order %.4f",
+                          alpha, q, (unsigned long)n, order);
+                }
+                previous = err;
+            }
+        }
+    free(w);
+    free(f);
+}
+
 /* The literal O(N) sum over the straight line xi_i = i Delta on [0, x]
  * against the O(1) closed form, for the contact law's alpha = -1/2 and two
  * other orders. Rounding alone separates them: the compensated sum is exact
@@ -96,11 +129,20 @@ static void test_line_ratio(void)
     /* 1 + 3/(8N) + O(N^-2): at N = 1e6 the O(N^-2) rest is ~1e-13. */
     CHECK(fabs(g1_line_ratio(-0.5, 1e6) - (1.0 + 3.0 / 8e6)) < 1e-12, "expansion at N = 1e6: %.17g",
           g1_line_ratio(-0.5, 1e6));
+    /* With r(N) = 1 + 3/(8N) - 7/(128 N^2) + O(N^-3) (Tricomi-Erdelyi), the
+     * extrapolation over N and N/2 leaves 1 + 7/(64 N^2) + O(N^-3); the
+     * combination itself rounds to a few ulp (1e-15). */
+    for (N = 10; N <= 1000000; N *= 10) {
+        double n = (double)N, ext = g1_line_ratio_extrapolated(-0.5, n);
+        CHECK(fabs(ext - 1.0 - 7.0 / (64.0 * n * n)) < 1.0 / (n * n * n) + 1e-15, "extrapolated ratio at N = %ld: %.17g",
+              N, ext);
+    }
 }
 
 int main(void)
 {
     test_power_rule_order();
+    test_extrapolated_order();
     test_line_identity();
     test_line_ratio();
     return check_summary("test_g1");
