@@ -1,0 +1,227 @@
+#include "reference.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_roots.h>
+
+/* y = (x1, v, x2, E_diss): x1' = v - F/c, v' = accel - F/m, x2' = F/c,
+ * E_diss' = F^2/c with F = K max(x1, 0)^(3/2). */
+typedef struct {
+    double K, inv_c, inv_m, accel;
+    long evaluations;
+} ode;
+
+static double force(const ode *o, double x1)
+{
+    return x1 > 0.0 ? o->K * x1 * sqrt(x1) : 0.0;
+}
+
+static int rhs(double t, const double y[], double f[], void *params)
+{
+    ode *o = params;
+    double F = force(o, y[0]);
+    (void)t;
+    o->evaluations++;
+    f[0] = y[1] - F * o->inv_c;
+    f[1] = o->accel - o->inv_m * F;
+    f[2] = F * o->inv_c;
+    f[3] = F * F * o->inv_c;
+    return GSL_SUCCESS;
+}
+
+static int jacobian(double t, const double y[], double *dfdy, double dfdt[], void *params)
+{
+    const ode *o = params;
+    double x1 = y[0] > 0.0 ? y[0] : 0.0, F = force(o, y[0]), dF = 1.5 * o->K * sqrt(x1);
+    (void)t;
+    memset(dfdy, 0, 16 * sizeof *dfdy);
+    dfdy[0] = -dF * o->inv_c;
+    dfdy[1] = 1.0;
+    dfdy[4] = -o->inv_m * dF;
+    dfdy[8] = dF * o->inv_c;
+    dfdy[12] = 2.0 * F * dF * o->inv_c;
+    memset(dfdt, 0, 4 * sizeof *dfdt);
+    return GSL_SUCCESS;
+}
+
+/* x1 (which = 0) or its rate x1' (which = 1) at the state y. */
+static double event_value(const ode *o, int which, const double y[4])
+{
+    return which == 0 ? y[0] : y[1] - force(o, y[0]) * o->inv_c;
+}
+
+typedef struct {
+    gsl_odeiv2_driver *driver;
+    ode *o;
+    int status;
+} integrator;
+
+/* y1 = y(t1) from y0 = y(t0), from a fresh start so that the result depends
+ * on t1 alone (root finding needs a function, not a history). */
+static void integrate(integrator *in, double t0, const double y0[4], double t1, double y1[4])
+{
+    double t = t0;
+    memcpy(y1, y0, 4 * sizeof *y1);
+    if (t1 <= t0)
+        return;
+    gsl_odeiv2_driver_reset_hstart(in->driver, 1e-3 * (t1 - t0));
+    if (in->status == GSL_SUCCESS)
+        in->status = gsl_odeiv2_driver_apply(in->driver, &t, t1, y1);
+}
+
+typedef struct {
+    integrator *in;
+    double t0;
+    const double *y0;
+    int which;
+} event_at;
+
+static double event_function(double t1, void *params)
+{
+    const event_at *e = params;
+    double y[4];
+    integrate(e->in, e->t0, e->y0, t1, y);
+    return event_value(e->in->o, e->which, y);
+}
+
+/* The time in (t0, t1] at which event `which` changes sign, given that it
+ * does; Brent's method to within a few ulp of the time. */
+static double event_time(integrator *in, double t0, const double y0[4], double t1, int which)
+{
+    event_at e = {in, t0, y0, which};
+    gsl_function fn = {event_function, &e};
+    gsl_root_fsolver *solver = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
+    double lo = t0, hi = t1, root = t1;
+    int i, status = GSL_CONTINUE;
+    if (!solver || gsl_root_fsolver_set(solver, &fn, lo, hi) != GSL_SUCCESS) {
+        gsl_root_fsolver_free(solver);
+        return t1;
+    }
+    for (i = 0; i < 200 && status == GSL_CONTINUE; i++) {
+        gsl_root_fsolver_iterate(solver);
+        root = gsl_root_fsolver_root(solver);
+        lo = gsl_root_fsolver_x_lower(solver);
+        hi = gsl_root_fsolver_x_upper(solver);
+        status = gsl_root_test_interval(lo, hi, 0.0, 4e-16);
+    }
+    gsl_root_fsolver_free(solver);
+    return root;
+}
+
+/* Whether the dashpot's relaxation rate 1.5 (K/c) sqrt(x1), at the Hertz
+ * indentation scale, is fast against the contact time scale. */
+static int is_stiff(const ode *o, double v0, double x_ref)
+{
+    double lambda = 1.5 * o->K * o->inv_c * sqrt(x_ref);
+    return !(v0 > 0.0 && lambda * x_ref / v0 < 100.0);
+}
+
+int reference_solve(const contact_params *p, double v0, double m, double rtol, double t_end,
+                    long impacts, double out_dt, reference_sample sample, void *ctx,
+                    reference_result *r, char *msg, size_t len)
+{
+    contact_model cm;
+    ode o;
+    integrator in;
+    gsl_odeiv2_system sys;
+    double scale[4], x_ref, y[4], y1[4], t = 0.0, next_sample = 0.0, v_onset = v0, t_onset = 0.0;
+    int in_contact;
+    gsl_error_handler_t *previous = gsl_set_error_handler_off();
+
+    contact_start(&cm, p, v0, m);
+    o.K = contact_spring_stiffness(&cm, 0); /* the continuous law (N fixed, or N -> infinity) */
+    o.inv_c = cm.inv_c;
+    o.inv_m = cm.inv_m;
+    o.accel = cm.accel;
+    o.evaluations = 0;
+    memset(r, 0, sizeof *r);
+
+    /* Tolerance scales: the Hertz indentation of the impact, or the
+     * indentation at which the dashpot takes over a driven rate. */
+    x_ref = o.inv_m > 0.0 ? pow(1.25 * v0 * v0 / (o.inv_m * o.K), 0.4) : pow(fabs(v0) * p->c / o.K, 2.0 / 3.0);
+    if (!(x_ref > 0.0) || !isfinite(x_ref))
+        x_ref = p->gap0 > 0.0 ? p->gap0 : 1e-6;
+    scale[0] = scale[2] = 1e-3 * x_ref;
+    scale[1] = 1e-3 * (fabs(v0) > 0.0 ? fabs(v0) : sqrt(fabs(p->g) * x_ref) + 1e-9);
+    scale[3] = 1e-3 * o.K * pow(x_ref, 2.5);
+    r->stiff = is_stiff(&o, fabs(v0), x_ref);
+    if (!(out_dt > 0.0)) /* events are bracketed per output interval: 1/64 of the contact's time scale */
+        out_dt = fabs(v0) > 0.0 ? x_ref / fabs(v0) / 64.0 : 1e-6;
+
+    sys.function = rhs;
+    sys.jacobian = jacobian;
+    sys.dimension = 4;
+    sys.params = &o;
+    in.o = &o;
+    in.status = GSL_SUCCESS;
+    in.driver = gsl_odeiv2_driver_alloc_scaled_new(&sys, r->stiff ? gsl_odeiv2_step_msbdf : gsl_odeiv2_step_rk8pd,
+                                                   1e-12, rtol, rtol, 1.0, 0.0, scale);
+    if (!in.driver) {
+        snprintf(msg, len, "reference: GSL could not allocate its driver");
+        gsl_set_error_handler(previous);
+        return -1;
+    }
+    gsl_odeiv2_driver_set_nmax(in.driver, 0);
+
+    y[0] = -p->gap0;
+    y[1] = v0;
+    y[2] = y[3] = 0.0;
+    in_contact = y[0] >= 0.0 && (v0 > 0.0 || (v0 == 0.0 && o.accel > 0.0));
+    while (r->impacts < impacts && t < t_end && in.status == GSL_SUCCESS) {
+        double t1 = next_sample < t_end ? next_sample : t_end;
+        if (t1 <= t) {
+            if (sample)
+                sample(ctx, t, force(&o, y[0]), y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+            next_sample += out_dt;
+            continue;
+        }
+        integrate(&in, t, y, t1, y1);
+        if (!in_contact && y1[0] > 0.0) {           /* onset inside (t, t1] */
+            t1 = event_time(&in, t, y, t1, 0);
+            integrate(&in, t, y, t1, y1);
+            y1[0] = 0.0;
+            in_contact = 1;
+            v_onset = y1[1];
+            t_onset = t1;
+        } else if (in_contact) {
+            if (event_value(&o, 1, y) > 0.0 && event_value(&o, 1, y1) <= 0.0) { /* the force peaks */
+                double tp = event_time(&in, t, y, t1, 1), yp[4];
+                integrate(&in, t, y, tp, yp);
+                if (force(&o, yp[0]) > r->F_peak)
+                    r->F_peak = force(&o, yp[0]);
+            }
+            if (y1[0] <= 0.0) {                      /* separation inside (t, t1] */
+                t1 = event_time(&in, t, y, t1, 0);
+                integrate(&in, t, y, t1, y1);
+                y1[0] = 0.0;
+                in_contact = 0;
+                r->impacts++;
+                r->eps = v_onset > 0.0 ? -y1[1] / v_onset : 0.0;
+                r->t_contact = t1 - t_onset;
+            }
+        }
+        if (force(&o, y1[0]) > r->F_peak)
+            r->F_peak = force(&o, y1[0]);
+        t = t1;
+        memcpy(y, y1, sizeof y);
+    }
+    if (sample)
+        sample(ctx, t, force(&o, y[0]), y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+    r->t = t;
+    r->v = y[1];
+    r->x1 = y[0] > 0.0 ? y[0] : 0.0;
+    r->x_perm = y[2];
+    r->E_diss = y[3];
+    r->rhs_evaluations = o.evaluations;
+    gsl_odeiv2_driver_free(in.driver);
+    gsl_set_error_handler(previous);
+    if (in.status != GSL_SUCCESS) {
+        snprintf(msg, len, "reference: GSL's integrator failed at t = %.9g s (%s)", t, gsl_strerror(in.status));
+        return -1;
+    }
+    return 0;
+}
