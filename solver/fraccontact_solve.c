@@ -323,7 +323,7 @@ static int solve_model(const options *o, series *out, figures *f)
         keep_state(out, &cm);
     t0 = cpu_now();
     /* Stop short of t_end by rounding only, not by a sliver of a step. */
-    while (cm.s.impacts < o->impacts && cm.s.t < o->t_end - 1e-9 * chunk) {
+    while (cm.s.impacts < o->impacts && cm.s.t < o->t_end - 1e-6 * chunk) {
         double H = fmin(chunk, o->t_end - cm.s.t);
         if (isnan(contact_advance(&cm, H))) {
             fprintf(stderr, PROGRAM ": the state became non-finite near t = %.9g s\n", cm.s.t);
