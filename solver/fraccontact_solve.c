@@ -81,6 +81,7 @@ static void usage(FILE *out)
     fprintf(out, "  %-18s %s\n\n", "--help", "this text");
     fprintf(out,
             "Output (table, or --json keys): F_peak [N], eps, t_contact [s], x_perm [m], E_diss [J],\n"
+            "v_end [m/s] (striker velocity where the solve stopped),\n"
             "steps (internal steps; the reference: right-hand-side evaluations), cpu_seconds (of the\n"
             "solve alone), impacts, separated, t_end [s] (where the solve stopped).\n"
             "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
@@ -202,7 +203,7 @@ static int parse(int argc, char **argv, options *o)
 /* ------------------------------------------------------------ results */
 
 typedef struct {
-    double t, F, x1, x2, v, E_diss;
+    double t, F, x, x1, x2, v, E_diss;
 } row;
 
 typedef struct {
@@ -211,7 +212,7 @@ typedef struct {
     int failed;
 } series;
 
-static void keep(void *ctx, double t, double F, double x1, double x2, double v, double E_diss)
+static void keep(void *ctx, double t, double F, double x, double x1, double x2, double v, double E_diss)
 {
     series *s = ctx;
     if (s->failed)
@@ -228,6 +229,7 @@ static void keep(void *ctx, double t, double F, double x1, double x2, double v, 
     }
     s->rows[s->n].t = t;
     s->rows[s->n].F = F;
+    s->rows[s->n].x = x;
     s->rows[s->n].x1 = x1;
     s->rows[s->n].x2 = x2;
     s->rows[s->n].v = v;
@@ -237,7 +239,8 @@ static void keep(void *ctx, double t, double F, double x1, double x2, double v, 
 
 static void keep_state(series *s, const contact_model *cm)
 {
-    keep(s, cm->s.t, cm->s.F, contact_elastic_indentation(cm), cm->s.x2, cm->s.v, cm->s.E_diss);
+    keep(s, cm->s.t, cm->s.F, contact_total_indentation(cm), contact_elastic_indentation(cm), cm->s.x2, cm->s.v,
+         cm->s.E_diss);
 }
 
 /* Written to FILE.tmp and renamed, so that an interrupted run never leaves a
@@ -258,7 +261,7 @@ static int write_csv(const char *path, const series *s)
     fprintf(f, "t_s,F_N,x_m,x1_m,x2_m,v_m_per_s,E_diss_J\n");
     for (i = 0; i < s->n; i++) {
         const row *r = &s->rows[i];
-        fprintf(f, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", r->t, r->F, r->x1 + r->x2, r->x1, r->x2,
+        fprintf(f, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", r->t, r->F, r->x, r->x1, r->x2,
                 r->v, r->E_diss);
     }
     ok = !ferror(f);
@@ -273,7 +276,7 @@ static int write_csv(const char *path, const series *s)
 }
 
 typedef struct {
-    double F_peak, eps, t_contact, x_perm, E_diss, cpu_seconds, t_end;
+    double F_peak, eps, t_contact, x_perm, E_diss, v_end, cpu_seconds, t_end;
     long steps, impacts;
 } figures;
 
@@ -284,10 +287,10 @@ static void print_results(const options *o, const figures *f, double k)
     const char *method = o->reference ? "reference" : schemes[o->p.scheme];
     if (o->json) {
         printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
-               "\"E_diss\": %.17g, \"steps\": %ld, \"cpu_seconds\": %.9g, "
+               "\"E_diss\": %.17g, \"v_end\": %.17g, \"steps\": %ld, \"cpu_seconds\": %.9g, "
                "\"impacts\": %ld, \"separated\": %s, \"t_end\": %.17g, \"law\": \"%s\", "
                "\"method\": \"%s\", \"dt\": %.17g, \"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g}\n",
-               f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->steps, f->cpu_seconds,
+               f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->steps, f->cpu_seconds,
                f->impacts, f->impacts > 0 ? "true" : "false", f->t_end, laws[o->p.law], method,
                o->p.dt_max, k, o->p.c, o->m, o->v0);
         return;
@@ -299,6 +302,7 @@ static void print_results(const options *o, const figures *f, double k)
     printf("  t_contact  %.10g s\n", f->t_contact);
     printf("  x_perm     %.10g m\n", f->x_perm);
     printf("  E_diss     %.10g J\n", f->E_diss);
+    printf("  v_end      %.10g m/s\n", f->v_end);
     printf("  impacts    %ld%s (t = %.6g s)\n", f->impacts, f->impacts > 0 ? "" : ", no separation by --t-end",
            f->t_end);
     printf("  steps      %ld\n", f->steps);
@@ -345,6 +349,7 @@ static int solve_model(const options *o, series *out, figures *f)
     f->t_contact = cm.s.t_contact;
     f->x_perm = cm.s.x2;
     f->E_diss = cm.s.E_diss;
+    f->v_end = cm.s.v;
     f->steps = cm.s.steps;
     f->impacts = cm.s.impacts;
     f->t_end = cm.s.t;
@@ -367,6 +372,7 @@ static int solve_reference(const options *o, series *out, figures *f)
     f->t_contact = r.t_contact;
     f->x_perm = r.x_perm;
     f->E_diss = r.E_diss;
+    f->v_end = r.v;
     f->steps = r.rhs_evaluations;
     f->impacts = r.impacts;
     f->t_end = r.t;

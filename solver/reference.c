@@ -175,7 +175,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
         double t1 = next_sample < t_end ? next_sample : t_end;
         if (t1 <= t) {
             if (sample)
-                sample(ctx, t, force(&o, y[0]), y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+                sample(ctx, t, force(&o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
             next_sample += out_dt;
             continue;
         }
@@ -210,7 +210,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
         memcpy(y, y1, sizeof y);
     }
     if (sample)
-        sample(ctx, t, force(&o, y[0]), y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+        sample(ctx, t, force(&o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
     r->t = t;
     r->v = y[1];
     r->x1 = y[0] > 0.0 ? y[0] : 0.0;

@@ -19,8 +19,10 @@ typedef struct {
     int stiff;           /* 1: BDF was used */
 } reference_result;
 
-/* Called at every output time with t, F, x1, x2, v, E_diss. */
-typedef void (*reference_sample)(void *ctx, double t, double F, double x1, double x2, double v, double E_diss);
+/* Called at every output time with t, F, x (total indentation), x1 (the
+ * elastic one), x2, v, E_diss. */
+typedef void (*reference_sample)(void *ctx, double t, double F, double x, double x1, double x2, double v,
+                                 double E_diss);
 
 /* Solves from t = 0 (striker at gap0, velocity v0, mass m as in
  * contact_start) until `impacts` impacts have ended or t_end, at relative
