@@ -107,12 +107,20 @@ int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
     return 0;
 }
 
+/* The G1 ratio of the law on N intervals (MODEL.md §4). */
+static double g1_ratio(int law, double N)
+{
+    return law == CONTACT_LAW_G1 ? g1_line_ratio(-0.5, N) : g1_line_ratio_extrapolated(-0.5, N);
+}
+
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
 {
     memset(cm, 0, sizeof *cm);
     cm->p = *p;
     cm->k = p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
     cm->inv_c = 1.0 / p->c;
+    cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
+                  : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, (double)p->g1_nodes) : 0.0;
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
@@ -134,14 +142,9 @@ void contact_drive(contact_model *cm, double v, double m)
 
 double contact_spring_stiffness(const contact_model *cm, long n_steps)
 {
-    long N;
-    if (cm->p.law == CONTACT_LAW_HERTZ)
-        return cm->k;
-    N = cm->p.g1_nodes > 0 ? cm->p.g1_nodes : n_steps;
-    if (N < 1)
-        return cm->k;
-    return cm->k * (cm->p.law == CONTACT_LAW_G1 ? g1_line_ratio(-0.5, (double)N)
-                                                : g1_line_ratio_extrapolated(-0.5, (double)N));
+    if (cm->p.law == CONTACT_LAW_HERTZ || cm->p.g1_nodes > 0)
+        return cm->k_fixed;
+    return n_steps > 0 ? cm->k * g1_ratio(cm->p.law, (double)n_steps) : cm->k;
 }
 
 /* The root s > 0 of s^2 + beta s^3 = r (r > 0, beta >= 0): s^2 is the elastic

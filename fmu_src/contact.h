@@ -62,6 +62,7 @@ typedef struct {
     contact_params p;
     double k;         /* the Hertz constant in use (given, or derived) */
     double inv_c;     /* 1/c */
+    double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
     contact_state s;
