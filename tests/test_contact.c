@@ -1,5 +1,6 @@
 /* The contact model against identities that hold whatever its step:
  * momentum, energy, closed forms, order of convergence, stability. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -101,10 +102,12 @@ static void test_elastic_limit(void)
 }
 
 /* However stiff the dashpot split and however long the step: finite, no
- * tension, the momentum identity to rounding, and eps in [0, 1] up to the
- * scheme's second-order error, bounded by (dt / t_c)^2 with t_c the Hertz
- * contact time (nearly elastic cases at dt = t_c / 13 overshoot by 1.4e-4
- * against the 6e-3 allowed). */
+ * tension, the momentum identity to rounding, and, up to the scheme's
+ * second-order error bounded by (dt / t_c)^2 with t_c the Hertz contact time
+ * (and the energy's rounding, an ulp a step at worst),
+ * eps in [0, 1] and no more energy dissipated and left than came in (nearly
+ * elastic cases at dt = t_c / 13 overshoot by 1.4e-4 against the 6e-3
+ * allowed). */
 static void test_stability(void)
 {
     static const double cs[] = {1e-2, 1.0, 1e2, 6080.0, 1e6, 1e9};
@@ -127,6 +130,10 @@ static void test_stability(void)
                 CHECK(fabs(M * (V0 - cm.s.v) - cs[i] * cm.s.x2) <= 1e-12 * M * V0,
                       "law %d c %g dt %g: momentum m (v0 - v) = %.17g vs c x2 = %.17g",
                       law, cs[i], dt, M * (V0 - cm.s.v), cs[i] * cm.s.x2);
+                CHECK(cm.s.E_diss + 0.5 * M * cm.s.v * cm.s.v
+                          <= 0.5 * M * V0 * V0 * (1.0 + (dt / t_c) * (dt / t_c) + DBL_EPSILON * cm.s.steps),
+                      "law %d c %g dt %g: E_diss %.17g + kinetic energy exceed the impact energy",
+                      law, cs[i], dt, cm.s.E_diss);
             }
 }
 
