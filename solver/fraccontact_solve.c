@@ -82,7 +82,8 @@ static void usage(FILE *out)
     fprintf(out, "  %-18s %s\n\n", "--help", "this text");
     fprintf(out,
             "Output (table, or --json keys): F_peak [N], eps, t_contact [s], x_perm [m], E_diss [J],\n"
-            "v_end [m/s] (striker velocity where the solve stopped),\n"
+            "v_end [m/s], x_end [m], x1_end [m] (striker velocity, total and elastic indentation where\n"
+            "the solve stopped),\n"
             "steps (internal steps; the reference: right-hand-side evaluations), cpu_seconds (of the\n"
             "solve alone), impacts, separated, t_end [s] (where the solve stopped).\n"
             "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
@@ -279,7 +280,7 @@ static int write_csv(const char *path, const series *s)
 }
 
 typedef struct {
-    double F_peak, eps, t_contact, x_perm, E_diss, v_end, cpu_seconds, t_end;
+    double F_peak, eps, t_contact, x_perm, E_diss, v_end, x_end, x1_end, cpu_seconds, t_end;
     long steps, impacts;
 } figures;
 
@@ -290,10 +291,12 @@ static void print_results(const options *o, const figures *f, double k)
     const char *method = o->reference ? "reference" : schemes[o->p.scheme];
     if (o->json) {
         printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
-               "\"E_diss\": %.17g, \"v_end\": %.17g, \"steps\": %ld, \"cpu_seconds\": %.9g, "
+               "\"E_diss\": %.17g, \"v_end\": %.17g, \"x_end\": %.17g, \"x1_end\": %.17g, "
+               "\"steps\": %ld, \"cpu_seconds\": %.9g, "
                "\"impacts\": %ld, \"separated\": %s, \"t_end\": %.17g, \"law\": \"%s\", "
                "\"method\": \"%s\", \"dt\": %.17g, \"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g}\n",
-               f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->steps, f->cpu_seconds,
+               f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->x_end, f->x1_end, f->steps,
+               f->cpu_seconds,
                f->impacts, f->impacts > 0 ? "true" : "false", f->t_end, laws[o->p.law], method,
                o->p.dt_max, k, o->p.c, o->m, o->v0);
         return;
@@ -362,6 +365,8 @@ static int solve_model(const options *o, series *out, figures *f)
     f->x_perm = cm.s.x2;
     f->E_diss = cm.s.E_diss;
     f->v_end = cm.s.v;
+    f->x_end = contact_total_indentation(&cm);
+    f->x1_end = contact_elastic_indentation(&cm);
     f->steps = cm.s.steps;
     f->impacts = cm.s.impacts;
     f->t_end = cm.s.t;
@@ -385,6 +390,8 @@ static int solve_reference(const options *o, series *out, figures *f)
     f->x_perm = r.x_perm;
     f->E_diss = r.E_diss;
     f->v_end = r.v;
+    f->x_end = r.x;
+    f->x1_end = r.x1;
     f->steps = r.rhs_evaluations;
     f->impacts = r.impacts;
     f->t_end = r.t;

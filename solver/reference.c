@@ -214,6 +214,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     r->t = t;
     r->v = y[1];
     r->x1 = y[0] > 0.0 ? y[0] : 0.0;
+    r->x = y[0] + y[2];
     r->x_perm = y[2];
     r->E_diss = y[3];
     r->rhs_evaluations = o.evaluations;

@@ -13,7 +13,7 @@
 typedef struct {
     double F_peak, eps, t_contact, x_perm, E_diss;
     double t;            /* where the solve stopped [s] */
-    double v, x1;        /* striker velocity and elastic indentation there */
+    double v, x, x1;     /* striker velocity, total and elastic indentation there */
     long impacts;
     long rhs_evaluations;
     int stiff;           /* 1: BDF was used */
