@@ -11,30 +11,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "contact.h"
 #include "g1.h"
 #include "g1_grid.h"
-
-static double cpu_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int by_value(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *x, int n)
-{
-    qsort(x, (size_t)n, sizeof *x, by_value);
-    return x[n / 2];
-}
+#include "timing.h"
 
 /* ns per internal step over the h20 contact: 100 steps per call, as an FMU
  * with a 10 us communication step takes them. */
@@ -49,10 +30,10 @@ static double ns_per_step(int law)
         contact_default_params(&p);
         p.law = law;
         contact_start(&cm, &p, 0.626418, 0.7437);
-        t0 = cpu_now();
+        t0 = cpu_seconds();
         while (cm.s.impacts == 0)
             contact_advance(&cm, 100 * p.dt_max);
-        runs[r] = (cpu_now() - t0) / (double)cm.s.steps * 1e9;
+        runs[r] = (cpu_seconds() - t0) / (double)cm.s.steps * 1e9;
     }
     return median(runs, 15);
 }
@@ -68,10 +49,10 @@ static double ns_literal_sum(size_t N)
     for (i = 0; i <= N; i++)
         f[i] = (double)i / (double)N;
     for (r = 0; r < 9; r++) {
-        double t0 = cpu_now();
+        double t0 = cpu_seconds();
         for (k = 0; k < reps; k++)
             sink += g1_history_sum(-0.5, w, f, N + 1, 1.0 / (double)N);
-        runs[r] = (cpu_now() - t0) / reps * 1e9;
+        runs[r] = (cpu_seconds() - t0) / reps * 1e9;
     }
     free(w);
     free(f);
@@ -116,18 +97,18 @@ static int bench_g1(size_t N, double alpha)
     for (i = 0; i <= N; i++)
         f[i] = (double)i * delta;
     for (r = 0; r < 9; r++) {
-        double t0 = cpu_now();
+        double t0 = cpu_seconds();
         for (k = 0; k < reps; k++) {
             g1_weights(alpha, N + 1, w); /* the weights are part of the work, as in any caller */
             newest = g1_history_sum(alpha, w, f, N + 1, delta);
         }
-        t_newest[r] = (cpu_now() - t0) / reps;
+        t_newest[r] = (cpu_seconds() - t0) / reps;
     }
     for (r = 0; r < 5; r++) {
-        double t0 = cpu_now();
+        double t0 = cpu_seconds();
         if (g1_full_grid(alpha, f, N + 1, delta, head, out) != 0)
             return 1;
-        t_full[r] = cpu_now() - t0;
+        t_full[r] = cpu_seconds() - t0;
     }
     for (i = 1; i <= N; i++) {
         double value = line_value(alpha, i, delta);

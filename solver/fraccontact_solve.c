@@ -9,11 +9,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "contact.h"
 #include "reference.h"
+#include "timing.h"
 
 #define PROGRAM "fraccontact-solve"
 #define G_EARTH 9.81
@@ -315,20 +315,6 @@ static void print_results(const options *o, const figures *f, double k)
     printf("  cpu        %.6g s\n", f->cpu_seconds);
 }
 
-/* CPU time of this process, to the nanosecond (clock() ticks in us). */
-static double cpu_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int by_value(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* ------------------------------------------------------------ the solves */
 
 static int solve_model(const options *o, series *out, figures *f)
@@ -336,11 +322,11 @@ static int solve_model(const options *o, series *out, figures *f)
     contact_model cm;
     double chunk = o->output_interval > 0.0 ? o->output_interval : o->p.dt_max, t0;
     int progress = !o->quiet && !o->json && isatty(STDERR_FILENO);
-    double shown = cpu_now();
+    double shown = cpu_seconds();
     contact_start(&cm, &o->p, o->v0, o->m);
     if (out)
         keep_state(out, &cm);
-    t0 = cpu_now();
+    t0 = cpu_seconds();
     /* Stop short of t_end by rounding only, not by a sliver of a step. */
     while (cm.s.impacts < o->impacts && cm.s.t < o->t_end - 1e-6 * chunk) {
         double H = fmin(chunk, o->t_end - cm.s.t);
@@ -350,15 +336,15 @@ static int solve_model(const options *o, series *out, figures *f)
         }
         if (out)
             keep_state(out, &cm);
-        if (progress && (cm.s.steps & 0xffff) == 0 && cpu_now() - shown > 0.5) {
-            shown = cpu_now();
+        if (progress && (cm.s.steps & 0xffff) == 0 && cpu_seconds() - shown > 0.5) {
+            shown = cpu_seconds();
             fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %ld steps, %ld of %ld impacts   ", cm.s.t, o->t_end,
                     cm.s.steps, cm.s.impacts, (long)o->impacts);
         }
     }
     if (progress && shown > t0)
         fprintf(stderr, "\n");
-    f->cpu_seconds = cpu_now() - t0;
+    f->cpu_seconds = cpu_seconds() - t0;
     f->F_peak = cm.s.F_peak;
     f->eps = cm.s.eps;
     f->t_contact = cm.s.t_contact;
@@ -377,13 +363,13 @@ static int solve_reference(const options *o, series *out, figures *f)
 {
     reference_result r;
     char why[300];
-    double t0 = cpu_now();
+    double t0 = cpu_seconds();
     if (reference_solve(&o->p, o->v0, o->m, o->rtol, o->t_end, o->impacts, o->output_interval, out ? keep : NULL, out, &r,
                         why, sizeof why) != 0) {
         fprintf(stderr, PROGRAM ": %s\n", why);
         return -1;
     }
-    f->cpu_seconds = cpu_now() - t0;
+    f->cpu_seconds = cpu_seconds() - t0;
     f->F_peak = r.F_peak;
     f->eps = r.eps;
     f->t_contact = r.t_contact;
@@ -410,8 +396,7 @@ static int solve(const options *o, series *out, figures *f)
             times[i] = f->cpu_seconds;
     }
     if (status == 0) {
-        qsort(times, (size_t)o->repeat, sizeof *times, by_value);
-        f->cpu_seconds = times[o->repeat / 2];
+        f->cpu_seconds = median(times, o->repeat);
     }
     free(times);
     return status;
