@@ -157,7 +157,8 @@ def write(path, steps, impacts, g1, alpha):
     out = ["# Benchmarks", "",
            "Regenerate: `scripts/report benchmarks` (a few minutes). Everything below was measured side by side "
            f"in one run, on {platform.processor() or platform.machine()} ({platform.system()}), one process, "
-           "CPU time, medians of repeated runs.", "",
+           "CPU time, medians of repeated runs. On this shared virtual machine the same binary's timings move by "
+           "up to 30 % from one run to the next; the ratios within one run are steadier.", "",
            "## Cost of an internal step", "",
            "The h20 contact (dt = 1e-7 s, 13 160 steps), 100 internal steps per `contact_advance` call as the FMU "
            "takes them with a 10 us communication step (`fraccontact-bench step`).", "",
