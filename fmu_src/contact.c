@@ -113,14 +113,19 @@ static double g1_ratio(int law, double N)
     return law == CONTACT_LAW_G1 ? g1_line_ratio(-0.5, N) : g1_line_ratio_extrapolated(-0.5, N);
 }
 
-void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
+void contact_configure(contact_model *cm, const contact_params *p)
 {
-    memset(cm, 0, sizeof *cm);
     cm->p = *p;
     cm->k = p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, (double)p->g1_nodes) : 0.0;
+}
+
+void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
+{
+    memset(cm, 0, sizeof *cm);
+    contact_configure(cm, p);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
@@ -426,10 +431,11 @@ static int internal_step(contact_model *cm, double h, double *impulse)
     return sdirk_internal_step(cm, h, impulse);
 }
 
-static int state_is_finite(const contact_state *s)
+int contact_state_is_finite(const contact_state *s)
 {
-    return isfinite(s->x1) && isfinite(s->x2) && isfinite(s->v) && isfinite(s->F)
-           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->eps);
+    return isfinite(s->t) && isfinite(s->x1) && isfinite(s->x2) && isfinite(s->v) && isfinite(s->F)
+           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->eps) && isfinite(s->v_onset)
+           && isfinite(s->t_onset) && isfinite(s->t_contact) && isfinite(s->x_prev) && isfinite(s->h_prev);
 }
 
 double contact_advance(contact_model *cm, double H)
@@ -447,7 +453,7 @@ double contact_advance(contact_model *cm, double H)
     for (i = 0; i < steps; i++)
         if (internal_step(cm, h, &impulse) != 0)
             break;
-    if (i < steps || !state_is_finite(&cm->s)) {
+    if (i < steps || !contact_state_is_finite(&cm->s)) {
         cm->s = start;
         return NAN;
     }

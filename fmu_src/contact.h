@@ -81,6 +81,10 @@ int contact_check_params(const contact_params *p, char *msg, size_t len);
 /* The same for the striker inputs: velocity v [m/s] and mass m [kg]. */
 int contact_check_striker(int scene, double v, double m, char *msg, size_t len);
 
+/* Takes the parameters and the constants derived from them (k, 1/c, a fixed
+ * stiffness), leaving the state alone: for a state restored from elsewhere. */
+void contact_configure(contact_model *cm, const contact_params *p);
+
 /* Starts at t = 0 with the striker at the gap gap0 moving at v0 (towards the
  * specimen). Parameters and striker must have passed the checks above. */
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m);
@@ -96,6 +100,9 @@ void contact_drive(contact_model *cm, double v, double m);
  * numerical failure (a non-finite state) returns NaN and leaves the state at
  * the start of the failing internal step. */
 double contact_advance(contact_model *cm, double H);
+
+/* Whether every value of the state is finite. */
+int contact_state_is_finite(const contact_state *s);
 
 /* Outputs derived from the state. */
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */

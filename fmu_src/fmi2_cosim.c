@@ -2,6 +2,8 @@
  * logging, and the translation of FMI calls onto fmu_model. It knows the
  * standard, not the physics. */
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +11,7 @@
 #include "fmi2Functions.h"
 #include "fmu_model.h"
 #include "guid.h"
+#include "serial.h"
 
 /* The states of FMI 2.0 §4.2.4 that a synchronous slave can be in, as bits,
  * so that each function names the set of states it may be called in. */
@@ -389,6 +392,175 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     return fmi2Discard;
 }
 
+/* ------------------------------------------------------------ FMU state */
+
+/* An FMU state is its serialized bytes, so that getting, setting,
+ * serializing and deserializing share one format and one set of checks:
+ *   "FCST", format, CRC-32 of the GUID, payload length, CRC-32 of the payload,
+ *   then the payload: the instance's mode and start time, then the model's
+ *   state (fm_state_write). All integers little-endian. */
+#define STATE_MAGIC "FCST"
+#define STATE_FORMAT 1u
+#define STATE_HEADER 20u
+#define STATE_INSTANCE 12u /* mode (u32), start time (f64) */
+
+typedef struct {
+    size_t size;
+    unsigned char bytes[1]; /* size bytes follow */
+} fmu_state;
+
+static size_t state_size(void)
+{
+    return STATE_HEADER + STATE_INSTANCE + fm_state_size();
+}
+
+static fmu_state *new_state(void)
+{
+    fmu_state *state = malloc(offsetof(fmu_state, bytes) + state_size());
+    if (state)
+        state->size = state_size();
+    return state;
+}
+
+static void write_state(const instance *in, unsigned char *b)
+{
+    size_t payload = state_size() - STATE_HEADER;
+    unsigned char *p = b + STATE_HEADER;
+    serial_put_u32(p, (uint32_t)in->state);
+    serial_put_double(p + 4, in->start_time);
+    fm_state_write(&in->fm, p + STATE_INSTANCE);
+    memcpy(b, STATE_MAGIC, 4);
+    serial_put_u32(b + 4, STATE_FORMAT);
+    serial_put_u32(b + 8, serial_crc32((const unsigned char *)FRACCONTACT_GUID, strlen(FRACCONTACT_GUID)));
+    serial_put_u32(b + 12, (uint32_t)payload);
+    serial_put_u32(b + 16, serial_crc32(p, payload));
+}
+
+/* NULL when the bytes are a whole, undamaged state of this FMU and format;
+ * otherwise what is wrong with them. */
+static const char *state_problem(const unsigned char *b, size_t size)
+{
+    size_t payload = state_size() - STATE_HEADER;
+    if (size < STATE_HEADER || memcmp(b, STATE_MAGIC, 4) != 0)
+        return "not a fraccontact FMU state";
+    if (serial_get_u32(b + 4) != STATE_FORMAT)
+        return "an FMU state of another format version";
+    if (serial_get_u32(b + 8) != serial_crc32((const unsigned char *)FRACCONTACT_GUID, strlen(FRACCONTACT_GUID)))
+        return "an FMU state of another FMU (its GUID differs)";
+    if (serial_get_u32(b + 12) != payload || size != state_size())
+        return "an FMU state of the wrong length (truncated, or of another version)";
+    if (serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))
+        return "a corrupted FMU state (its checksum does not match)";
+    return NULL;
+}
+
+static int valid_mode(uint32_t mode)
+{
+    return mode == INSTANTIATED || mode == INITIALIZATION_MODE || mode == STEP_COMPLETE || mode == STEP_FAILED
+           || mode == TERMINATED;
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    instance *in = c;
+    fmu_state *state;
+    REQUIRE(ANY_STATE, "fmi2GetFMUstate");
+    if (!FMUstate)
+        return fail(in, "fmi2GetFMUstate: FMUstate is NULL");
+    state = *FMUstate ? (fmu_state *)*FMUstate : new_state(); /* a given state is overwritten */
+    if (!state)
+        return fail(in, "fmi2GetFMUstate: out of memory");
+    write_state(in, state->bytes);
+    *FMUstate = state;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    instance *in = c;
+    const fmu_state *state = FMUstate;
+    const char *problem;
+    char message[200];
+    uint32_t mode;
+    REQUIRE(ANY_STATE, "fmi2SetFMUstate");
+    if (!state)
+        return fail(in, "fmi2SetFMUstate: FMUstate is NULL");
+    problem = state_problem(state->bytes, state->size);
+    mode = serial_get_u32(state->bytes + STATE_HEADER);
+    if (!problem && !valid_mode(mode))
+        problem = "an FMU state with an impossible mode";
+    if (problem) {
+        snprintf(message, sizeof message, "fmi2SetFMUstate: %s", problem);
+        return fail(in, message);
+    }
+    if (fm_state_read(&in->fm, state->bytes + STATE_HEADER + STATE_INSTANCE) != FM_OK)
+        return fmi2Error;
+    in->start_time = serial_get_double(state->bytes + STATE_HEADER + 4);
+    in->state = (int)mode;
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    instance *in = c;
+    REQUIRE(ANY_STATE, "fmi2FreeFMUstate");
+    if (FMUstate) {
+        free(*FMUstate);
+        *FMUstate = NULL;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+{
+    instance *in = c;
+    REQUIRE(ANY_STATE, "fmi2SerializedFMUstateSize");
+    if (!FMUstate || !size)
+        return fail(in, "fmi2SerializedFMUstateSize: FMUstate or size is NULL");
+    *size = ((const fmu_state *)FMUstate)->size;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
+{
+    instance *in = c;
+    const fmu_state *state = FMUstate;
+    char message[200];
+    REQUIRE(ANY_STATE, "fmi2SerializeFMUstate");
+    if (!state || !serializedState)
+        return fail(in, "fmi2SerializeFMUstate: FMUstate or serializedState is NULL");
+    if (size < state->size) {
+        snprintf(message, sizeof message, "fmi2SerializeFMUstate: size = %lu, but the state takes %lu bytes",
+                 (unsigned long)size, (unsigned long)state->size);
+        return fail(in, message);
+    }
+    memcpy(serializedState, state->bytes, state->size);
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
+{
+    instance *in = c;
+    const char *problem;
+    fmu_state *state;
+    char message[200];
+    REQUIRE(ANY_STATE, "fmi2DeSerializeFMUstate");
+    if (!serializedState || !FMUstate)
+        return fail(in, "fmi2DeSerializeFMUstate: serializedState or FMUstate is NULL");
+    problem = state_problem((const unsigned char *)serializedState, size);
+    if (problem) {
+        snprintf(message, sizeof message, "fmi2DeSerializeFMUstate: %s (%lu bytes)", problem, (unsigned long)size);
+        return fail(in, message);
+    }
+    state = *FMUstate ? (fmu_state *)*FMUstate : new_state();
+    if (!state)
+        return fail(in, "fmi2DeSerializeFMUstate: out of memory");
+    memcpy(state->bytes, serializedState, size);
+    *FMUstate = state;
+    return fmi2OK;
+}
+
 /* ------------------------------------- capabilities this FMU does not declare */
 
 static fmi2Status unsupported(instance *in, int states, const char *name, const char *flag)
@@ -398,49 +570,6 @@ static fmi2Status unsupported(instance *in, int states, const char *name, const 
         return fmi2Error;
     snprintf(message, sizeof message, "%s is not supported (modelDescription.xml: %s=\"false\")", name, flag);
     return fail(in, message);
-}
-
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    (void)FMUstate;
-    return unsupported(c, ANY_STATE, "fmi2GetFMUstate", "canGetAndSetFMUstate");
-}
-
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
-{
-    (void)FMUstate;
-    return unsupported(c, ANY_STATE, "fmi2SetFMUstate", "canGetAndSetFMUstate");
-}
-
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    (void)FMUstate;
-    return unsupported(c, ANY_STATE, "fmi2FreeFMUstate", "canGetAndSetFMUstate");
-}
-
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
-{
-    (void)FMUstate;
-    (void)size;
-    return unsupported(c, ANY_STATE, "fmi2SerializedFMUstateSize", "canSerializeFMUstate");
-}
-
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
-                                 size_t size)
-{
-    (void)FMUstate;
-    (void)serializedState;
-    (void)size;
-    return unsupported(c, ANY_STATE, "fmi2SerializeFMUstate", "canSerializeFMUstate");
-}
-
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                   fmi2FMUstate *FMUstate)
-{
-    (void)serializedState;
-    (void)size;
-    (void)FMUstate;
-    return unsupported(c, ANY_STATE, "fmi2DeSerializeFMUstate", "canSerializeFMUstate");
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],

@@ -1,5 +1,7 @@
 #include "fmu_model.h"
 
+#include "serial.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -263,5 +265,87 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
                       "it is kept at the start of the step", t, t + H);
     fm->F_avg = impulse / H;
     report_events(fm, &before);
+    return FM_OK;
+}
+
+/* ------------------------------------------------------------ FMU state */
+
+/* Every value a simulation depends on, field by field: a raw copy of the
+ * struct would carry the logger's pointers and the compiler's padding into
+ * another process. The rest (k, 1/c, ...) is derived again on reading. */
+typedef enum { F64, I32, I64 } field_kind;
+
+typedef struct {
+    size_t offset;
+    field_kind kind;
+} state_field;
+
+#define F(field) {offsetof(fmu_model, field), F64}
+#define I(field) {offsetof(fmu_model, field), I32}
+#define L(field) {offsetof(fmu_model, field), I64}
+
+static const state_field state_fields[] = {
+    F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
+    F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
+    I(params.scheme), F(v), F(m), F(F_avg), I(started), F(model.inv_m), F(model.accel),
+    F(model.s.t), F(model.s.x1), F(model.s.x2), F(model.s.v), F(model.s.F), F(model.s.F_peak),
+    F(model.s.E_diss), F(model.s.eps), F(model.s.v_onset), F(model.s.t_onset), F(model.s.t_contact),
+    F(model.s.x_prev), F(model.s.h_prev), L(model.s.n), L(model.s.steps), L(model.s.impacts),
+    I(model.s.in_contact)};
+
+#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
+
+static size_t field_size(field_kind kind)
+{
+    return kind == I32 ? 4 : 8;
+}
+
+size_t fm_state_size(void)
+{
+    size_t i, n = 0;
+    for (i = 0; i < N_STATE_FIELDS; i++)
+        n += field_size(state_fields[i].kind);
+    return n;
+}
+
+void fm_state_write(const fmu_model *fm, unsigned char *bytes)
+{
+    size_t i;
+    for (i = 0; i < N_STATE_FIELDS; i++) {
+        const char *at = (const char *)fm + state_fields[i].offset;
+        if (state_fields[i].kind == F64)
+            serial_put_double(bytes, *(const double *)at);
+        else if (state_fields[i].kind == I32)
+            serial_put_u32(bytes, (uint32_t) * (const int *)at);
+        else
+            serial_put_u64(bytes, (uint64_t) * (const long *)at);
+        bytes += field_size(state_fields[i].kind);
+    }
+}
+
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
+{
+    fmu_model trial = *fm;
+    char why[256];
+    size_t i;
+    for (i = 0; i < N_STATE_FIELDS; i++) {
+        char *at = (char *)&trial + state_fields[i].offset;
+        if (state_fields[i].kind == F64)
+            *(double *)at = serial_get_double(bytes);
+        else if (state_fields[i].kind == I32)
+            *(int *)at = (int)(int32_t)serial_get_u32(bytes);
+        else
+            *(long *)at = (long)(int64_t)serial_get_u64(bytes);
+        bytes += field_size(state_fields[i].kind);
+    }
+    if (contact_check_params(&trial.params, why, sizeof why) != 0
+        || contact_check_striker(CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
+    if (!contact_state_is_finite(&trial.model.s) || !isfinite(trial.F_avg) || !isfinite(trial.model.inv_m)
+        || !isfinite(trial.model.accel) || (trial.started != 0 && trial.started != 1)
+        || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1))
+        return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
+    contact_configure(&trial.model, &trial.params);
+    *fm = trial;
     return FM_OK;
 }

@@ -53,4 +53,11 @@ fm_status fm_start(fmu_model *fm, double t0);
 /* One communication step [t, t + H]. */
 fm_status fm_do_step(fmu_model *fm, double t, double H);
 
+/* The model's part of the FMU state, as fm_state_size() bytes in the
+ * platform-independent layout of serial.h. fm_state_read takes it back only
+ * if it describes a valid model (else FM_ERROR, a report, nothing changed). */
+size_t fm_state_size(void);
+void fm_state_write(const fmu_model *fm, unsigned char *bytes);
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes);
+
 #endif
