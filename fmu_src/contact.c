@@ -132,17 +132,26 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
         cm->inv_m = 1.0 / m;
         cm->accel = p->g;
     } else {
-        contact_drive(cm, v0, m);
+        contact_drive(cm, v0, m, 0.0);
     }
 }
 
-void contact_drive(contact_model *cm, double v, double m)
+void contact_drive(contact_model *cm, double v, double m, double slope)
 {
     if (cm->p.scene != CONTACT_SCENE_DRIVEN)
         return;
     cm->s.v = v;
     cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;
-    cm->accel = m > 0.0 ? cm->p.g : 0.0;
+    cm->accel = m > 0.0 ? cm->p.g : slope;
+}
+
+void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate)
+{
+    const contact_state *s = &cm->s;
+    double x1 = contact_elastic_indentation(cm);
+    *x1_rate = s->in_contact ? s->v - s->F * cm->inv_c : 0.0;
+    *v_rate = cm->accel - cm->inv_m * s->F;
+    *F_rate = x1 > 0.0 ? 1.5 * contact_spring_stiffness(cm, s->n) * sqrt(x1) * *x1_rate : 0.0;
 }
 
 double contact_spring_stiffness(const contact_model *cm, long n_steps)
@@ -471,7 +480,12 @@ double contact_total_indentation(const contact_model *cm)
     return cm->s.x1 + cm->s.x2;
 }
 
+double contact_semi_integral_per_force(const contact_model *cm)
+{
+    return 1.0 / (GAMMA_5_2 * cm->k);
+}
+
 double contact_semi_integral(const contact_model *cm)
 {
-    return cm->s.F / (GAMMA_5_2 * cm->k);
+    return cm->s.F * contact_semi_integral_per_force(cm);
 }

@@ -91,8 +91,13 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
 
 /* Driven scene: the indentation rate v from now on; m > 0 lets the model move
  * the striker with that inertia until the next call (a proxy striker), m = 0
- * holds v. The drop test ignores the call: its striker is the model's own. */
-void contact_drive(contact_model *cm, double v, double m);
+ * prescribes the rate: v + slope (t - now) (slope 0: v held). The drop test
+ * ignores the call: its striker is the model's own. */
+void contact_drive(contact_model *cm, double v, double m, double slope);
+
+/* The state's rates now: x1' (0 out of contact), v', and the spring force's
+ * F' = 1.5 K sqrt(x1) x1' at the current stiffness. */
+void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate);
 
 /* Advances the model by H >= 0 in equal internal steps of at most dt_max that
  * land exactly on t + H, locating contact onset and separation within a step.
@@ -108,6 +113,7 @@ int contact_state_is_finite(const contact_state *s);
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */
 double contact_total_indentation(const contact_model *cm);    /* x = x1 + x2 */
 double contact_semi_integral(const contact_model *cm);        /* the D^(-1/2) x1 used for F */
+double contact_semi_integral_per_force(const contact_model *cm); /* 1/(Gamma(5/2) k): F to it */
 
 /* The spring's stiffness K, its force being K x1^(3/2): k for the Hertz law,
  * k Gamma(N+3/2)/(Gamma(N) N^(3/2)) for the G1 law on N intervals (MODEL.md §4)

@@ -588,20 +588,29 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
-    (void)vr;
-    (void)nvr;
-    (void)order;
-    (void)value;
-    return unsupported(c, SETTABLE, "fmi2SetRealInputDerivatives", "canInterpolateInputs");
+    instance *in = c;
+    size_t i;
+    REQUIRE(SETTABLE, "fmi2SetRealInputDerivatives");
+    if (null_arrays(in, nvr, vr, value, "fmi2SetRealInputDerivatives")
+        || null_arrays(in, nvr, order, order, "fmi2SetRealInputDerivatives"))
+        return fmi2Error;
+    for (i = 0; i < nvr; i++)
+        if (fm_set_input_derivative(&in->fm, vr[i], order[i], value[i]) != FM_OK)
+            return fmi2Error;
+    return fmi2OK;
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[])
 {
-    (void)vr;
-    (void)nvr;
-    (void)order;
-    (void)value;
-    return unsupported(c, STEPPING | ERROR_STATE, "fmi2GetRealOutputDerivatives",
-                       "maxOutputDerivativeOrder");
+    instance *in = c;
+    size_t i;
+    REQUIRE(STEPPING | ERROR_STATE, "fmi2GetRealOutputDerivatives");
+    if (null_arrays(in, nvr, vr, value, "fmi2GetRealOutputDerivatives")
+        || null_arrays(in, nvr, order, order, "fmi2GetRealOutputDerivatives"))
+        return fmi2Error;
+    for (i = 0; i < nvr; i++)
+        if (fm_get_output_derivative(&in->fm, vr[i], order[i], &value[i]) != FM_OK)
+            return fmi2Error;
+    return fmi2OK;
 }

@@ -149,6 +149,8 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
                               vr == VR_m ? value : fm->m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     *(double *)((char *)fm + var->offset) = value;
+    if (vr == VR_v)
+        fm->v_slope = 0.0; /* a new value: the old slope no longer describes it */
     return FM_OK;
 }
 
@@ -210,6 +212,50 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
     return FM_OK;
 }
 
+static fm_status order_one(fmu_model *fm, const char *what, unsigned vr, int order)
+{
+    if (order == 1)
+        return FM_OK;
+    return report(fm, FM_ERROR, "logStatusError", "%s: order %d for value reference %u: only order 1 is provided",
+                  what, order, vr);
+}
+
+fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
+{
+    if (order_one(fm, "fmi2SetRealInputDerivatives", vr, order) != FM_OK)
+        return FM_ERROR;
+    if (vr != VR_v)
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2SetRealInputDerivatives: value reference %u: only v (%d) takes a derivative", vr, VR_v);
+    if (!isfinite(value))
+        return report(fm, FM_ERROR, "logStatusError", "fmi2SetRealInputDerivatives: dv/dt = %g must be finite",
+                      value);
+    fm->v_slope = value;
+    return FM_OK;
+}
+
+fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value)
+{
+    const contact_model *cm = &fm->model;
+    double x1_rate, v_rate, F_rate;
+    if (order_one(fm, "fmi2GetRealOutputDerivatives", vr, order) != FM_OK)
+        return FM_ERROR;
+    contact_rates(cm, &x1_rate, &v_rate, &F_rate);
+    switch (vr) {
+    case VR_F: *value = F_rate; return FM_OK;
+    case VR_x: *value = cm->s.v; return FM_OK;
+    case VR_x1: *value = x1_rate; return FM_OK;
+    case VR_x2: *value = cm->s.F * cm->inv_c; return FM_OK;
+    case VR_v_striker: *value = v_rate; return FM_OK;
+    case VR_E_diss: *value = cm->s.F * cm->s.F * cm->inv_c; return FM_OK;
+    case VR_semi_integral: *value = F_rate * contact_semi_integral_per_force(cm); return FM_OK;
+    default:
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2GetRealOutputDerivatives: value reference %u has no time derivative here "
+                      "(F, x, x1, x2, v_striker, E_diss, semi_integral have)", vr);
+    }
+}
+
 fm_status fm_start(fmu_model *fm, double t0)
 {
     char why[256];
@@ -256,7 +302,7 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     cm->s.t = t;
     if (H == 0.0)
         return FM_OK;
-    contact_drive(cm, fm->v, fm->m);
+    contact_drive(cm, fm->v, fm->m, fm->v_slope);
     before = cm->s;
     impulse = contact_advance(cm, H);
     if (isnan(impulse))
@@ -287,7 +333,7 @@ typedef struct {
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
-    I(params.scheme), F(v), F(m), F(F_avg), I(started), F(model.inv_m), F(model.accel),
+    I(params.scheme), F(v), F(m), F(v_slope), F(F_avg), I(started), F(model.inv_m), F(model.accel),
     F(model.s.t), F(model.s.x1), F(model.s.x2), F(model.s.v), F(model.s.F), F(model.s.F_peak),
     F(model.s.E_diss), F(model.s.eps), F(model.s.v_onset), F(model.s.t_onset), F(model.s.t_contact),
     F(model.s.x_prev), F(model.s.h_prev), L(model.s.n), L(model.s.steps), L(model.s.impacts),
@@ -341,7 +387,8 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
     if (contact_check_params(&trial.params, why, sizeof why) != 0
         || contact_check_striker(CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
-    if (!contact_state_is_finite(&trial.model.s) || !isfinite(trial.F_avg) || !isfinite(trial.model.inv_m)
+    if (!contact_state_is_finite(&trial.model.s) || !isfinite(trial.F_avg) || !isfinite(trial.v_slope)
+        || !isfinite(trial.model.inv_m)
         || !isfinite(trial.model.accel) || (trial.started != 0 && trial.started != 1)
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1))
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");

@@ -29,6 +29,7 @@ typedef void (*fm_report)(void *env, fm_status status, const char *category, con
 typedef struct {
     contact_params params;
     double v, m;          /* the inputs as last set */
+    double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
     double F_avg;         /* impulse of the last communication step / its length */
     int started;          /* past initialization: fixed parameters are frozen */
     contact_model model;
@@ -45,6 +46,12 @@ fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value);
 fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value);
 fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value);
 fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value);
+
+/* Input and output derivatives (order 1): the slope of v over the next
+ * step (it lapses when v is set again), and the rates of the outputs that
+ * change continuously. */
+fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value);
+fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value);
 
 /* End of initialization: checks the inputs against the scene, starts the
  * model at time t0 and freezes the fixed parameters. */
