@@ -1,5 +1,5 @@
 /* FMI 2.0 co-simulation glue: instances, the call-sequence state machine,
- * logging, and the translation of FMI calls onto fmu_model. It knows the
+ * logging, and the translation of FMI calls onto a model (fmu_interface.h). It knows the
  * standard, not the physics. */
 #include <math.h>
 #include <stddef.h>
@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "fmu_model.h"
+#include "fmu_interface.h"
 #include "guid.h"
 #include "serial.h"
 
@@ -39,7 +39,7 @@ typedef struct {
     int logging_on;
     int category_on[N_CATEGORIES];
     double start_time;
-    fmu_model fm;
+    fmu_model *fm;
 } instance;
 
 /* The logger formats its message like printf: protect any '%' we pass on. */
@@ -141,14 +141,20 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         fail(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
         return NULL;
     }
-    if (!fmuGUID || strcmp(fmuGUID, FRACCONTACT_GUID) != 0) {
-        fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FRACCONTACT_GUID ")");
+    if (!fmuGUID || strcmp(fmuGUID, FMU_GUID) != 0) {
+        fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FMU_GUID ")");
         return NULL;
     }
     in = calloc(1, sizeof *in);
-    if (in)
+    if (in) {
         in->name = malloc(strlen(instanceName) + 1);
-    if (!in || !in->name) {
+        in->fm = fm_new(report_from_model, in);
+    }
+    if (!in || !in->name || !in->fm) {
+        if (in) {
+            free(in->name);
+            fm_free(in->fm);
+        }
         free(in);
         fail(&probe, "fmi2Instantiate: out of memory");
         return NULL;
@@ -158,9 +164,6 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     in->logging_on = loggingOn != fmi2False;
     memset(in->category_on, 1, sizeof in->category_on);
     in->state = INSTANTIATED;
-    in->fm.report = report_from_model;
-    in->fm.report_env = in;
-    fm_reset(&in->fm);
     return in;
 }
 
@@ -169,6 +172,7 @@ void fmi2FreeInstance(fmi2Component c)
     instance *in = c;
     if (!in)
         return;
+    fm_free(in->fm);
     free(in->name);
     free(in);
 }
@@ -233,7 +237,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
     instance *in = c;
     REQUIRE(INITIALIZATION_MODE, "fmi2ExitInitializationMode");
-    if (fm_start(&in->fm, in->start_time) != FM_OK)
+    if (fm_start(in->fm, in->start_time) != FM_OK)
         return fmi2Error;
     in->state = STEP_COMPLETE;
     return fmi2OK;
@@ -251,7 +255,7 @@ fmi2Status fmi2Reset(fmi2Component c)
 {
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi2Reset");
-    fm_reset(&in->fm);
+    fm_reset(in->fm);
     in->start_time = 0.0;
     in->state = INSTANTIATED;
     return fmi2OK;
@@ -269,7 +273,7 @@ fmi2Status fmi2Reset(fmi2Component c)
         if (null_arrays(in, nvr, vr, value, #fn))                             \
             return fmi2Error;                                                 \
         for (i = 0; i < nvr; i++)                                             \
-            if (get(&in->fm, vr[i], &value[i]) != FM_OK)                      \
+            if (get(in->fm, vr[i], &value[i]) != FM_OK)                      \
                 return fmi2Error;                                             \
         return fmi2OK;                                                        \
     }
@@ -284,7 +288,7 @@ fmi2Status fmi2Reset(fmi2Component c)
         if (null_arrays(in, nvr, vr, value, #fn))                             \
             return fmi2Error;                                                 \
         for (i = 0; i < nvr; i++)                                             \
-            if (set(&in->fm, vr[i], value[i]) != FM_OK)                       \
+            if (set(in->fm, vr[i], value[i]) != FM_OK)                       \
                 return fmi2Error;                                             \
         return fmi2OK;                                                        \
     }
@@ -302,30 +306,39 @@ static fm_status set_boolean(fmu_model *fm, unsigned vr, fmi2Boolean value)
     return fm_set_boolean(fm, vr, value != fmi2False);
 }
 
-/* This FMU has no String variable: every reference is an error. */
-static fm_status no_string(fmu_model *fm, unsigned vr, fmi2String value)
-{
-    char message[120];
-    (void)value;
-    snprintf(message, sizeof message, "value reference %u is not a String variable of this FMU (it has none)", vr);
-    fm->report(fm->report_env, FM_ERROR, "logStatusError", message);
-    return FM_ERROR;
-}
-
-static fm_status get_no_string(fmu_model *fm, unsigned vr, fmi2String *value)
-{
-    *value = NULL;
-    return no_string(fm, vr, NULL);
-}
-
 GET_LOOP(fmi2GetReal, fm_get_real, fmi2Real)
 GET_LOOP(fmi2GetInteger, fm_get_integer, fmi2Integer)
 GET_LOOP(fmi2GetBoolean, get_boolean, fmi2Boolean)
-GET_LOOP(fmi2GetString, get_no_string, fmi2String)
 SET_LOOP(fmi2SetReal, fm_set_real, fmi2Real)
 SET_LOOP(fmi2SetInteger, fm_set_integer, fmi2Integer)
 SET_LOOP(fmi2SetBoolean, set_boolean, fmi2Boolean)
-SET_LOOP(fmi2SetString, no_string, fmi2String)
+
+/* No FMU of this project has a String variable: every reference is an error. */
+static fmi2Status no_string(instance *in, const char *name, size_t nvr, const fmi2ValueReference vr[])
+{
+    char message[160];
+    if (nvr == 0)
+        return fmi2OK;
+    snprintf(message, sizeof message, "%s: value reference %u is not a String variable of this FMU (it has none)",
+             name, vr ? vr[0] : 0u);
+    return fail(in, message);
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[])
+{
+    instance *in = c;
+    (void)value;
+    REQUIRE(AFTER_INIT_ENTERED, "fmi2GetString");
+    return no_string(in, "fmi2GetString", nvr, vr);
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[])
+{
+    instance *in = c;
+    (void)value;
+    REQUIRE(SETTABLE, "fmi2SetString");
+    return no_string(in, "fmi2SetString", nvr, vr);
+}
 
 /* --------------------------------------------------------------- stepping */
 
@@ -335,7 +348,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     instance *in = c;
     (void)noSetFMUStatePriorToCurrentPoint;
     REQUIRE(STEP_COMPLETE, "fmi2DoStep");
-    return fm_do_step(&in->fm, currentCommunicationPoint, communicationStepSize) == FM_OK ? fmi2OK : fmi2Error;
+    return fm_do_step(in->fm, currentCommunicationPoint, communicationStepSize) == FM_OK ? fmi2OK : fmi2Error;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)
@@ -360,7 +373,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
     REQUIRE(STEPPING, "fmi2GetRealStatus");
     if (s != fmi2LastSuccessfulTime || !value)
         return fmi2Discard;
-    *value = in->fm.model.s.t;
+    *value = fm_time(in->fm);
     return fmi2OK;
 }
 
@@ -428,10 +441,10 @@ static void write_state(const instance *in, unsigned char *b)
     unsigned char *p = b + STATE_HEADER;
     serial_put_u32(p, (uint32_t)in->state);
     serial_put_double(p + 4, in->start_time);
-    fm_state_write(&in->fm, p + STATE_INSTANCE);
+    fm_state_write(in->fm, p + STATE_INSTANCE);
     memcpy(b, STATE_MAGIC, 4);
     serial_put_u32(b + 4, STATE_FORMAT);
-    serial_put_u32(b + 8, serial_crc32((const unsigned char *)FRACCONTACT_GUID, strlen(FRACCONTACT_GUID)));
+    serial_put_u32(b + 8, serial_crc32((const unsigned char *)FMU_GUID, strlen(FMU_GUID)));
     serial_put_u32(b + 12, (uint32_t)payload);
     serial_put_u32(b + 16, serial_crc32(p, payload));
 }
@@ -445,7 +458,7 @@ static const char *state_problem(const unsigned char *b, size_t size)
         return "not a fraccontact FMU state";
     if (serial_get_u32(b + 4) != STATE_FORMAT)
         return "an FMU state of another format version";
-    if (serial_get_u32(b + 8) != serial_crc32((const unsigned char *)FRACCONTACT_GUID, strlen(FRACCONTACT_GUID)))
+    if (serial_get_u32(b + 8) != serial_crc32((const unsigned char *)FMU_GUID, strlen(FMU_GUID)))
         return "an FMU state of another FMU (its GUID differs)";
     if (serial_get_u32(b + 12) != payload || size != state_size())
         return "an FMU state of the wrong length (truncated, or of another version)";
@@ -493,7 +506,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
         snprintf(message, sizeof message, "fmi2SetFMUstate: %s", problem);
         return fail(in, message);
     }
-    if (fm_state_read(&in->fm, state->bytes + STATE_HEADER + STATE_INSTANCE) != FM_OK)
+    if (fm_state_read(in->fm, state->bytes + STATE_HEADER + STATE_INSTANCE) != FM_OK)
         return fmi2Error;
     in->start_time = serial_get_double(state->bytes + STATE_HEADER + 4);
     in->state = (int)mode;
@@ -595,7 +608,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
         || null_arrays(in, nvr, order, order, "fmi2SetRealInputDerivatives"))
         return fmi2Error;
     for (i = 0; i < nvr; i++)
-        if (fm_set_input_derivative(&in->fm, vr[i], order[i], value[i]) != FM_OK)
+        if (fm_set_input_derivative(in->fm, vr[i], order[i], value[i]) != FM_OK)
             return fmi2Error;
     return fmi2OK;
 }
@@ -610,7 +623,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
         || null_arrays(in, nvr, order, order, "fmi2GetRealOutputDerivatives"))
         return fmi2Error;
     for (i = 0; i < nvr; i++)
-        if (fm_get_output_derivative(&in->fm, vr[i], order[i], &value[i]) != FM_OK)
+        if (fm_get_output_derivative(in->fm, vr[i], order[i], &value[i]) != FM_OK)
             return fmi2Error;
     return fmi2OK;
 }

@@ -6,7 +6,19 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+struct fmu_model {
+    contact_params params;
+    double v, m;          /* the inputs as last set */
+    double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
+    double F_avg;         /* impulse of the last communication step / its length */
+    int started;          /* past initialization: fixed parameters are frozen */
+    contact_model model;
+    fm_report report;
+    void *report_env;
+};
 
 typedef enum { REAL, INTEGER, BOOLEAN } var_type;
 typedef enum { PARAMETER, INPUT, OUTPUT } var_causality;
@@ -120,6 +132,27 @@ static void preview_start(fmu_model *fm)
         && contact_check_striker(CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0)
         /* The mass only scales the dynamics, which a preview does not run. */
         contact_start(&fm->model, &fm->params, fm->v, fm->m > 0.0 ? fm->m : 1.0);
+}
+
+fmu_model *fm_new(fm_report report, void *env)
+{
+    fmu_model *fm = calloc(1, sizeof *fm);
+    if (!fm)
+        return NULL;
+    fm->report = report;
+    fm->report_env = env;
+    fm_reset(fm);
+    return fm;
+}
+
+void fm_free(fmu_model *fm)
+{
+    free(fm);
+}
+
+double fm_time(const fmu_model *fm)
+{
+    return fm->model.s.t;
 }
 
 void fm_reset(fmu_model *fm)

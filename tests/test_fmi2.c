@@ -33,7 +33,7 @@ static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL
 
 static fmi2Component instantiate(const char *name)
 {
-    return fmi2Instantiate(name, fmi2CoSimulation, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+    return fmi2Instantiate(name, fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
 }
 
 static double get(fmi2Component c, fmi2ValueReference vr)
@@ -56,11 +56,11 @@ static void test_instantiate(void)
     fmi2Component c;
     c = fmi2Instantiate("x", fmi2CoSimulation, "{wrong}", "", &callbacks, fmi2False, fmi2False);
     CHECK(c == NULL && strstr(last_message, "fmuGUID"), "a wrong GUID is refused: %s", last_message);
-    c = fmi2Instantiate("x", fmi2ModelExchange, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+    c = fmi2Instantiate("x", fmi2ModelExchange, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
     CHECK(c == NULL && strstr(last_message, "co-simulation"), "model exchange is refused: %s", last_message);
-    c = fmi2Instantiate("", fmi2CoSimulation, FRACCONTACT_GUID, "", &callbacks, fmi2False, fmi2False);
+    c = fmi2Instantiate("", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
     CHECK(c == NULL && strstr(last_message, "instanceName"), "an empty name is refused: %s", last_message);
-    CHECK(fmi2Instantiate("x", fmi2CoSimulation, FRACCONTACT_GUID, "", NULL, fmi2False, fmi2False) == NULL,
+    CHECK(fmi2Instantiate("x", fmi2CoSimulation, FMU_GUID, "", NULL, fmi2False, fmi2False) == NULL,
           "no callbacks");
     CHECK(strcmp(fmi2GetVersion(), "2.0") == 0 && strcmp(fmi2GetTypesPlatform(), "default") == 0, "version");
     fmi2FreeInstance(NULL);

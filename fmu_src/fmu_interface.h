@@ -1,0 +1,51 @@
+/* What the FMI glue (fmi2_cosim.c) asks of a model: the hook interface each
+ * FMU of this project implements (fmu_model.c for the contact element,
+ * striker/striker_model.c for the striker). No FMI types: plain C values and
+ * statuses numerically equal to the FMI ones. */
+#ifndef FRACCONTACT_FMU_INTERFACE_H
+#define FRACCONTACT_FMU_INTERFACE_H
+
+#include <stddef.h>
+
+typedef enum { FM_OK = 0, FM_WARNING = 1, FM_ERROR = 3 } fm_status;
+
+/* Where a model reports: status, log category, message. */
+typedef void (*fm_report)(void *env, fm_status status, const char *category, const char *message);
+
+typedef struct fmu_model fmu_model; /* each model defines its own */
+
+/* A model with its start values, reporting through report(env, ...); NULL
+ * when memory runs out. */
+fmu_model *fm_new(fm_report report, void *env);
+void fm_free(fmu_model *fm);
+
+/* Start values; forgets any simulation. */
+void fm_reset(fmu_model *fm);
+
+fm_status fm_set_real(fmu_model *fm, unsigned vr, double value);
+fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value);
+fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value);
+fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value);
+fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value);
+fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value);
+
+/* Derivatives of real inputs and outputs (fmi2SetRealInputDerivatives,
+ * fmi2GetRealOutputDerivatives). */
+fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value);
+fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value);
+
+/* End of initialization: checks what the model needs, starts it at t0. */
+fm_status fm_start(fmu_model *fm, double t0);
+
+/* One communication step [t, t + H], and the model's time. */
+fm_status fm_do_step(fmu_model *fm, double t, double H);
+double fm_time(const fmu_model *fm);
+
+/* The model's part of the FMU state, as fm_state_size() bytes in the
+ * platform-independent layout of serial.h. fm_state_read takes it back only
+ * if it describes a valid model (else FM_ERROR, a report, nothing changed). */
+size_t fm_state_size(void);
+void fm_state_write(const fmu_model *fm, unsigned char *bytes);
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes);
+
+#endif
