@@ -1,9 +1,8 @@
 #include "fmu_model.h"
 
-#include "serial.h"
+#include "fmu_vars.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,101 +15,46 @@ struct fmu_model {
     double F_avg;         /* impulse of the last communication step / its length */
     int started;          /* past initialization: fixed parameters are frozen */
     contact_model model;
-    fm_report report;
-    void *report_env;
+    fmu_reporter log;
 };
-
-typedef enum { REAL, INTEGER, BOOLEAN } var_type;
-typedef enum { PARAMETER, INPUT, OUTPUT } var_causality;
-
-typedef struct {
-    unsigned vr;
-    const char *name;
-    var_type type;
-    var_causality causality;
-    size_t offset; /* of the stored value in fmu_model (parameters, inputs) */
-} variable;
 
 #define PARAM(field) offsetof(fmu_model, params.field)
 
-static const variable variables[] = {
-    {VR_v, "v", REAL, INPUT, offsetof(fmu_model, v)},
-    {VR_m, "m", REAL, INPUT, offsetof(fmu_model, m)},
-    {VR_R, "R", REAL, PARAMETER, PARAM(R)},
-    {VR_E_i, "E_i", REAL, PARAMETER, PARAM(E_i)},
-    {VR_nu_i, "nu_i", REAL, PARAMETER, PARAM(nu_i)},
-    {VR_E_s, "E_s", REAL, PARAMETER, PARAM(E_s)},
-    {VR_nu_s, "nu_s", REAL, PARAMETER, PARAM(nu_s)},
-    {VR_k, "k", REAL, PARAMETER, PARAM(k)},
-    {VR_c, "c", REAL, PARAMETER, PARAM(c)},
-    {VR_dt_max, "dt_max", REAL, PARAMETER, PARAM(dt_max)},
-    {VR_g, "g", REAL, PARAMETER, PARAM(g)},
-    {VR_gap0, "gap0", REAL, PARAMETER, PARAM(gap0)},
-    {VR_F, "F", REAL, OUTPUT, 0},
-    {VR_F_avg, "F_avg", REAL, OUTPUT, 0},
-    {VR_F_peak, "F_peak", REAL, OUTPUT, 0},
-    {VR_x, "x", REAL, OUTPUT, 0},
-    {VR_x1, "x1", REAL, OUTPUT, 0},
-    {VR_x2, "x2", REAL, OUTPUT, 0},
-    {VR_v_striker, "v_striker", REAL, OUTPUT, 0},
-    {VR_E_diss, "E_diss", REAL, OUTPUT, 0},
-    {VR_eps, "eps", REAL, OUTPUT, 0},
-    {VR_semi_integral, "semi_integral", REAL, OUTPUT, 0},
-    {VR_law, "law", INTEGER, PARAMETER, PARAM(law)},
-    {VR_g1_nodes, "g1_nodes", INTEGER, PARAMETER, PARAM(g1_nodes)},
-    {VR_scene, "scene", INTEGER, PARAMETER, PARAM(scene)},
-    {VR_contact, "contact", BOOLEAN, OUTPUT, 0},
+static const fmu_variable variable_list[] = {
+    {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v)},
+    {VR_m, "m", VAR_REAL, VAR_INPUT, offsetof(fmu_model, m)},
+    {VR_R, "R", VAR_REAL, VAR_PARAMETER, PARAM(R)},
+    {VR_E_i, "E_i", VAR_REAL, VAR_PARAMETER, PARAM(E_i)},
+    {VR_nu_i, "nu_i", VAR_REAL, VAR_PARAMETER, PARAM(nu_i)},
+    {VR_E_s, "E_s", VAR_REAL, VAR_PARAMETER, PARAM(E_s)},
+    {VR_nu_s, "nu_s", VAR_REAL, VAR_PARAMETER, PARAM(nu_s)},
+    {VR_k, "k", VAR_REAL, VAR_PARAMETER, PARAM(k)},
+    {VR_c, "c", VAR_REAL, VAR_PARAMETER, PARAM(c)},
+    {VR_dt_max, "dt_max", VAR_REAL, VAR_PARAMETER, PARAM(dt_max)},
+    {VR_g, "g", VAR_REAL, VAR_PARAMETER, PARAM(g)},
+    {VR_gap0, "gap0", VAR_REAL, VAR_PARAMETER, PARAM(gap0)},
+    {VR_F, "F", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_F_avg, "F_avg", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_F_peak, "F_peak", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_x, "x", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_x1, "x1", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_x2, "x2", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_v_striker, "v_striker", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_eps, "eps", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_semi_integral, "semi_integral", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_law, "law", VAR_INTEGER, VAR_PARAMETER, PARAM(law)},
+    {VR_g1_nodes, "g1_nodes", VAR_INTEGER, VAR_PARAMETER, PARAM(g1_nodes)},
+    {VR_scene, "scene", VAR_INTEGER, VAR_PARAMETER, PARAM(scene)},
+    {VR_contact, "contact", VAR_BOOLEAN, VAR_OUTPUT, 0},
 };
 
-static const char *const type_names[] = {"Real", "Integer", "Boolean"};
+static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static fm_status report(fmu_model *fm, fm_status status, const char *category, const char *fmt, ...)
-{
-    char message[512];
-    va_list args;
-    va_start(args, fmt);
-    vsnprintf(message, sizeof message, fmt, args);
-    va_end(args);
-    if (fm->report)
-        fm->report(fm->report_env, status, category, message);
-    return status;
-}
-
-/* The variable of that value reference and type, or NULL after an error report. */
-static const variable *find(fmu_model *fm, unsigned vr, var_type type)
-{
-    size_t i;
-    for (i = 0; i < sizeof variables / sizeof variables[0]; i++)
-        if (variables[i].vr == vr && variables[i].type == type)
-            return &variables[i];
-    report(fm, FM_ERROR, "logStatusError", "value reference %u is not a %s variable of this FMU",
-           vr, type_names[type]);
-    return NULL;
-}
-
-/* Whether the variable may be set now; reports why not. */
-static const variable *settable(fmu_model *fm, unsigned vr, var_type type)
-{
-    const variable *var = find(fm, vr, type);
-    if (!var)
-        return NULL;
-    if (var->causality == OUTPUT) {
-        report(fm, FM_ERROR, "logStatusError", "%s is an output; it cannot be set", var->name);
-        return NULL;
-    }
-    if (var->causality == PARAMETER && fm->started) {
-        report(fm, FM_ERROR, "logStatusError",
-               "%s is a fixed parameter; it can be set only before fmi2ExitInitializationMode", var->name);
-        return NULL;
-    }
-    return var;
-}
+#define report(fm, ...) fmu_say(&(fm)->log, __VA_ARGS__)
 
 /* Applies a parameter change only if the parameters stay valid. */
-static fm_status set_parameter(fmu_model *fm, const variable *var, const void *value, size_t size)
+static fm_status set_parameter(fmu_model *fm, const fmu_variable *var, const void *value, size_t size)
 {
     fmu_model trial = *fm;
     char why[256];
@@ -139,8 +83,8 @@ fmu_model *fm_new(fm_report report, void *env)
     fmu_model *fm = calloc(1, sizeof *fm);
     if (!fm)
         return NULL;
-    fm->report = report;
-    fm->report_env = env;
+    fm->log.report = report;
+    fm->log.env = env;
     fm_reset(fm);
     return fm;
 }
@@ -157,11 +101,9 @@ double fm_time(const fmu_model *fm)
 
 void fm_reset(fmu_model *fm)
 {
-    fm_report r = fm->report;
-    void *env = fm->report_env;
+    fmu_reporter log = fm->log;
     memset(fm, 0, sizeof *fm);
-    fm->report = r;
-    fm->report_env = env;
+    fm->log = log;
     contact_default_params(&fm->params);
     fm->v = 0.626418; /* sqrt(2 g h) for the paper's 20 mm drop */
     fm->m = 0.7437;
@@ -170,11 +112,11 @@ void fm_reset(fmu_model *fm)
 
 fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
 {
-    const variable *var = settable(fm, vr, REAL);
+    const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
     char why[256];
     if (!var)
         return FM_ERROR;
-    if (var->causality == PARAMETER)
+    if (var->causality == VAR_PARAMETER)
         return set_parameter(fm, var, &value, sizeof value);
     /* Inputs: the scene-dependent rule (m > 0 in the drop test) waits for
      * fm_start, since the scene may still change. */
@@ -207,23 +149,23 @@ static double real_output(const fmu_model *fm, unsigned vr)
 
 fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
 {
-    const variable *var = find(fm, vr, REAL);
+    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
     if (!var)
         return FM_ERROR;
     preview_start(fm);
-    *value = var->causality == OUTPUT ? real_output(fm, vr) : *(const double *)((const char *)fm + var->offset);
+    *value = var->causality == VAR_OUTPUT ? real_output(fm, vr) : *(const double *)((const char *)fm + var->offset);
     return FM_OK;
 }
 
 fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
 {
-    const variable *var = settable(fm, vr, INTEGER);
+    const fmu_variable *var = fmu_settable(&variables, vr, VAR_INTEGER, fm->started, &fm->log);
     return var ? set_parameter(fm, var, &value, sizeof value) : FM_ERROR;
 }
 
 fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
 {
-    const variable *var = find(fm, vr, INTEGER);
+    const fmu_variable *var = fmu_find(&variables, vr, VAR_INTEGER, &fm->log);
     if (!var)
         return FM_ERROR;
     *value = *(const int *)((const char *)fm + var->offset);
@@ -233,12 +175,12 @@ fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
 fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
 {
     (void)value;
-    return settable(fm, vr, BOOLEAN) ? FM_OK : FM_ERROR;
+    return fmu_settable(&variables, vr, VAR_BOOLEAN, fm->started, &fm->log) ? FM_OK : FM_ERROR;
 }
 
 fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
 {
-    if (!find(fm, vr, BOOLEAN))
+    if (!fmu_find(&variables, vr, VAR_BOOLEAN, &fm->log))
         return FM_ERROR;
     preview_start(fm);
     *value = fm->model.s.in_contact;
@@ -352,16 +294,9 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
 /* Every value a simulation depends on, field by field: a raw copy of the
  * struct would carry the logger's pointers and the compiler's padding into
  * another process. The rest (k, 1/c, ...) is derived again on reading. */
-typedef enum { F64, I32, I64 } field_kind;
-
-typedef struct {
-    size_t offset;
-    field_kind kind;
-} state_field;
-
-#define F(field) {offsetof(fmu_model, field), F64}
-#define I(field) {offsetof(fmu_model, field), I32}
-#define L(field) {offsetof(fmu_model, field), I64}
+#define F(field) {offsetof(fmu_model, field), FIELD_F64}
+#define I(field) {offsetof(fmu_model, field), FIELD_I32}
+#define L(field) {offsetof(fmu_model, field), FIELD_I64}
 
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
@@ -374,49 +309,21 @@ static const state_field state_fields[] = {
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
 
-static size_t field_size(field_kind kind)
-{
-    return kind == I32 ? 4 : 8;
-}
-
 size_t fm_state_size(void)
 {
-    size_t i, n = 0;
-    for (i = 0; i < N_STATE_FIELDS; i++)
-        n += field_size(state_fields[i].kind);
-    return n;
+    return fmu_fields_size(state_fields, N_STATE_FIELDS);
 }
 
 void fm_state_write(const fmu_model *fm, unsigned char *bytes)
 {
-    size_t i;
-    for (i = 0; i < N_STATE_FIELDS; i++) {
-        const char *at = (const char *)fm + state_fields[i].offset;
-        if (state_fields[i].kind == F64)
-            serial_put_double(bytes, *(const double *)at);
-        else if (state_fields[i].kind == I32)
-            serial_put_u32(bytes, (uint32_t) * (const int *)at);
-        else
-            serial_put_u64(bytes, (uint64_t) * (const long *)at);
-        bytes += field_size(state_fields[i].kind);
-    }
+    fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
 }
 
 fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
 {
     fmu_model trial = *fm;
     char why[256];
-    size_t i;
-    for (i = 0; i < N_STATE_FIELDS; i++) {
-        char *at = (char *)&trial + state_fields[i].offset;
-        if (state_fields[i].kind == F64)
-            *(double *)at = serial_get_double(bytes);
-        else if (state_fields[i].kind == I32)
-            *(int *)at = (int)(int32_t)serial_get_u32(bytes);
-        else
-            *(long *)at = (long)(int64_t)serial_get_u64(bytes);
-        bytes += field_size(state_fields[i].kind);
-    }
+    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
         || contact_check_striker(CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
