@@ -1,0 +1,198 @@
+/* The striker FMU: a rigid body of mass m under gravity g and the contact
+ * force F (input, pushing against its motion towards the specimen). Its
+ * position x (towards the specimen, the contact element's indentation
+ * coordinate) and velocity v are the outputs. With F held over a step the
+ * motion is a parabola, integrated exactly. */
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmu_interface.h"
+#include "fmu_vars.h"
+
+enum { VR_F = 1, VR_m = 2, VR_g = 3, VR_x0 = 4, VR_v0 = 5, VR_x = 6, VR_v = 7 };
+
+struct fmu_model {
+    double F;              /* input: contact force on the striker [N] */
+    double m, g, x0, v0;   /* parameters */
+    double t, x, v;        /* state */
+    int started;
+    fmu_reporter log;
+};
+
+static const fmu_variable variable_list[] = {
+    {VR_F, "F", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F)},
+    {VR_m, "m", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, m)},
+    {VR_g, "g", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, g)},
+    {VR_x0, "x0", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, x0)},
+    {VR_v0, "v0", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, v0)},
+    {VR_x, "x", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, x)},
+    {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
+};
+
+static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
+
+fmu_model *fm_new(fm_report report, void *env)
+{
+    fmu_model *fm = calloc(1, sizeof *fm);
+    if (!fm)
+        return NULL;
+    fm->log.report = report;
+    fm->log.env = env;
+    fm_reset(fm);
+    return fm;
+}
+
+void fm_free(fmu_model *fm)
+{
+    free(fm);
+}
+
+void fm_reset(fmu_model *fm)
+{
+    fmu_reporter log = fm->log;
+    memset(fm, 0, sizeof *fm);
+    fm->log = log;
+    fm->m = 0.7437;
+    fm->v0 = 0.626418;
+    fm->v = fm->v0;
+}
+
+/* The value's rule, or NULL if it is fine. */
+static const char *rule_broken(unsigned vr, double value)
+{
+    if (!isfinite(value))
+        return "must be finite";
+    if (vr == VR_m && !(value > 0.0))
+        return "the striker mass must be positive [kg]";
+    return NULL;
+}
+
+fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
+{
+    const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
+    const char *why;
+    if (!var)
+        return FM_ERROR;
+    why = rule_broken(vr, value);
+    if (why)
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "%s = %g is invalid: %s", var->name, value, why);
+    *(double *)((char *)fm + var->offset) = value;
+    if (!fm->started) { /* before initialization the outputs show the start */
+        fm->x = fm->x0;
+        fm->v = fm->v0;
+    }
+    return FM_OK;
+}
+
+fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
+{
+    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
+    if (!var)
+        return FM_ERROR;
+    *value = *(const double *)((const char *)fm + var->offset);
+    return FM_OK;
+}
+
+fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
+{
+    (void)value;
+    return fmu_settable(&variables, vr, VAR_INTEGER, fm->started, &fm->log) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
+{
+    (void)value;
+    return fmu_find(&variables, vr, VAR_INTEGER, &fm->log) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
+{
+    (void)value;
+    return fmu_settable(&variables, vr, VAR_BOOLEAN, fm->started, &fm->log) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
+{
+    (void)value;
+    return fmu_find(&variables, vr, VAR_BOOLEAN, &fm->log) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
+{
+    (void)value;
+    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
+                   "fmi2SetRealInputDerivatives: value reference %u, order %d: the striker holds its input", vr,
+                   order);
+}
+
+fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value)
+{
+    if (order == 1 && vr == VR_x) {
+        *value = fm->v;
+        return FM_OK;
+    }
+    if (order == 1 && vr == VR_v) {
+        *value = fm->g - fm->F / fm->m;
+        return FM_OK;
+    }
+    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
+                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x and v, order 1", vr, order);
+}
+
+fm_status fm_start(fmu_model *fm, double t0)
+{
+    fm->t = t0;
+    fm->x = fm->x0;
+    fm->v = fm->v0;
+    fm->started = 1;
+    return FM_OK;
+}
+
+fm_status fm_do_step(fmu_model *fm, double t, double H)
+{
+    double a = fm->g - fm->F / fm->m;
+    if (!isfinite(t) || !isfinite(H) || H < 0.0 || fabs(t - fm->t) > 1e-6 * H + 1e-12 * fabs(t))
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError",
+                       "fmi2DoStep: currentCommunicationPoint = %.17g, communicationStepSize = %.17g: the step "
+                       "must start at the FMU's time %.17g and be finite and >= 0", t, H, fm->t);
+    fm->x += H * (fm->v + 0.5 * H * a);
+    fm->v += H * a;
+    fm->t = t + H;
+    return FM_OK;
+}
+
+double fm_time(const fmu_model *fm)
+{
+    return fm->t;
+}
+
+#define F(field) {offsetof(fmu_model, field), FIELD_F64}
+
+static const state_field state_fields[] = {F(F), F(m), F(g), F(x0), F(v0), F(t), F(x), F(v),
+                                           {offsetof(fmu_model, started), FIELD_I32}};
+
+#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
+
+size_t fm_state_size(void)
+{
+    return fmu_fields_size(state_fields, N_STATE_FIELDS);
+}
+
+void fm_state_write(const fmu_model *fm, unsigned char *bytes)
+{
+    fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
+}
+
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
+{
+    fmu_model trial = *fm;
+    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
+    if (rule_broken(VR_F, trial.F) || rule_broken(VR_m, trial.m) || rule_broken(VR_g, trial.g)
+        || rule_broken(VR_x0, trial.x0) || rule_broken(VR_v0, trial.v0) || !isfinite(trial.t)
+        || !isfinite(trial.x) || !isfinite(trial.v) || (trial.started != 0 && trial.started != 1))
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
+    *fm = trial;
+    return FM_OK;
+}
