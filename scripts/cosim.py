@@ -1,0 +1,165 @@
+"""Co-simulation of the drop test as two FMUs: the striker (a rigid body)
+and the contact element in its driven scene, coupled through fmpy's FMU API
+as a master would couple them.
+
+Couplings:
+  zoh         the contact holds the striker's velocity over a step (m = 0)
+              and the striker holds the contact force F of the last point;
+  mass-aware  the contact runs a proxy striker of the same mass inside the
+              step (m > 0) and the striker receives F_avg, the step's
+              impulse divided by its length.
+Orders:
+  jacobi        both FMUs step from the values of the last point;
+  gauss-seidel  the contact steps first, the striker then takes its force.
+
+Used by scripts/cosim_study.py and tests/test_cosim.py; also a command:
+  .venv/bin/python scripts/cosim.py --step 1e-4 --coupling mass-aware --order gauss-seidel
+"""
+
+import argparse
+import json
+import pathlib
+
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+M, V0 = 0.7437, 0.626418
+COUPLINGS = ("zoh", "mass-aware")
+ORDERS = ("jacobi", "gauss-seidel")
+
+
+class Unit:
+    """One FMU instance, its variables by name."""
+
+    def __init__(self, path, name, values):
+        md = read_model_description(str(path))
+        self.folder = extract(str(path))
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.types = {v.name: v.type for v in md.modelVariables}
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.folder,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        for key, value in values.items():
+            self.set(key, value)
+        self.fmu.exitInitializationMode()
+
+    def set(self, name, value):
+        if self.types[name] == "Integer":
+            self.fmu.setInteger([self.vr[name]], [int(value)])
+        else:
+            self.fmu.setReal([self.vr[name]], [float(value)])
+
+    def get(self, *names):
+        values = self.fmu.getReal([self.vr[n] for n in names])
+        return values[0] if len(names) == 1 else values
+
+    def free(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def monolithic(contact_fmu, t_end=3e-3, H=1e-5):
+    """The reference: the contact FMU's own drop test, same model and dt_max."""
+    c = Unit(contact_fmu, "monolithic", {"law": 2, "v": V0, "m": M})
+    t = 0.0
+    while t < t_end - 1e-15:
+        c.fmu.doStep(t, H)
+        t += H
+    F_peak, eps, E_diss, v = c.get("F_peak", "eps", "E_diss", "v_striker")
+    c.free()
+    return dict(F_peak=F_peak, eps=eps, energy_error=(0.5 * M * v * v + E_diss) / (0.5 * M * V0 * V0) - 1)
+
+
+def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False):
+    """One co-simulation of the h20 drop; returns F_peak, eps (from the
+    striker's final velocity), the energy error and, with trace, the series."""
+    contact = Unit(contact_fmu, "contact", {"law": 2, "scene": 2, "v": V0,
+                                             "m": M if coupling == "mass-aware" else 0.0})
+    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0})
+    force = "F_avg" if coupling == "mass-aware" else "F"
+    F_held = 0.0
+    series = []
+    t, n = 0.0, 0
+    while t < t_end - 1e-15:
+        v = striker.get("v")
+        contact.set("v", v)
+        if order == "jacobi":
+            striker.set("F", F_held)
+            striker.fmu.doStep(t, H)
+            contact.fmu.doStep(t, H)
+            F_held = contact.get(force)
+        else:
+            contact.fmu.doStep(t, H)
+            striker.set("F", contact.get(force))
+            striker.fmu.doStep(t, H)
+        n += 1
+        t = n * H
+        if trace:
+            series.append((t, contact.get("F"), contact.get("F_avg"), striker.get("v"), striker.get("x")))
+    v_end = striker.get("v")
+    F_peak, E_diss = contact.get("F_peak", "E_diss")
+    contact.free()
+    striker.free()
+    result = dict(F_peak=F_peak, eps=-v_end / V0, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+    if trace:
+        result["series"] = series
+    return result
+
+
+def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
+    """The same scene in libcosim (Open Simulation Platform, via libcosimpy):
+    an independent FMI 2.0 importer. Its fixed-step algorithm steps every
+    FMU from the last exchanged values: the Jacobi order."""
+    from libcosimpy.CosimEnums import CosimVariableType  # noqa: F401  (imported for its side effects' absence)
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+    log_output_level(CosimLogLevel.ERROR)
+    cvr = {v.name: v.valueReference for v in read_model_description(str(contact_fmu)).modelVariables}
+    svr = {v.name: v.valueReference for v in read_model_description(str(striker_fmu)).modelVariables}
+    ex = CosimExecution.from_step_size(step_size=round(H * 1e9))  # libcosim counts nanoseconds
+    c = ex.add_local_slave(CosimLocalSlave(fmu_path=str(contact_fmu), instance_name="contact"))
+    s = ex.add_local_slave(CosimLocalSlave(fmu_path=str(striker_fmu), instance_name="striker"))
+    ex.integer_initial_value(c, cvr["law"], 2)
+    ex.integer_initial_value(c, cvr["scene"], 2)
+    ex.real_initial_value(c, cvr["v"], V0)
+    ex.real_initial_value(c, cvr["m"], M if coupling == "mass-aware" else 0.0)
+    ex.real_initial_value(s, svr["m"], M)
+    ex.real_initial_value(s, svr["v0"], V0)
+    ex.connect_real_variables(s, svr["v"], c, cvr["v"])
+    ex.connect_real_variables(c, cvr["F_avg" if coupling == "mass-aware" else "F"], s, svr["F"])
+    observer = CosimObserver.create_last_value()
+    ex.add_observer(observer)
+    ex.simulate_until(target_time=round(t_end * 1e9))
+    F_peak, E_diss = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"]])
+    v_end = observer.last_real_values(s, [svr["v"]])[0]
+    return dict(F_peak=F_peak, eps=-v_end / V0, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--contact", default=ROOT / "build" / "fraccontact.fmu", type=pathlib.Path)
+    parser.add_argument("--striker", default=ROOT / "build" / "striker.fmu", type=pathlib.Path)
+    parser.add_argument("--step", type=float, default=1e-5, help="communication step [s] (default 1e-5)")
+    parser.add_argument("--coupling", choices=COUPLINGS, default="mass-aware")
+    parser.add_argument("--order", choices=ORDERS + ("libcosim",), default="gauss-seidel",
+                        help="master order, or libcosim to run the scene in libcosim (Jacobi)")
+    parser.add_argument("--t-end", type=float, default=3e-3)
+    args = parser.parse_args()
+    if not args.step > 0:
+        parser.error("--step must be positive")
+    if args.order == "libcosim":
+        r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end)
+    else:
+        r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end)
+    ref = monolithic(args.contact)
+    print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] - ref["eps"],
+                          monolithic=ref)))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,184 @@
+"""Co-simulation study: the h20 drop test as striker FMU + contact FMU, for
+communication steps from 1e-6 s to 1e-3 s, in both coupling orders with a
+zero-order hold and with the mass-aware coupling, against the monolithic drop
+test; the Jacobi runs repeated in libcosim, an independent importer. Writes
+docs/cosimulation.md and docs/cosimulation.png.
+
+Regenerate: scripts/report cosim_study   (about two minutes)
+"""
+
+import argparse
+import pathlib
+import sys
+
+import numpy as np
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from cosim import COUPLINGS, M, ORDERS, V0, cosimulate, cosimulate_libcosim, monolithic  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+STEPS = [float(f"{h:.3g}") for h in np.logspace(-6, -3, 31)]
+K = 3.299e8
+
+
+def progress(done, total, what):
+    if sys.stderr.isatty():
+        print(f"\r[{'#' * int(30 * done / total):<30}] {done}/{total} {what:<40}", end="", file=sys.stderr, flush=True)
+
+
+def largest_step_within(rows, key, bound):
+    """The largest step from which on every smaller one keeps |key| within bound."""
+    best = None
+    for r in sorted(rows, key=lambda r: r["H"]):
+        if not abs(r[key]) <= bound:
+            break
+        best = r["H"]
+    return best
+
+
+def first_unstable(rows):
+    """The smallest step at which the coupling creates energy (> 1 % of the
+    impact energy): the sign of an unstable exchange."""
+    for r in sorted(rows, key=lambda r: r["H"]):
+        if r["energy_error"] > 0.01:
+            return r["H"]
+    return None
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
+    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
+    args = parser.parse_args()
+    contact, striker = args.build / "fraccontact.fmu", args.build / "striker.fmu"
+    ref = monolithic(contact)
+    runs = [(c, o) for c in COUPLINGS for o in ORDERS] + [(c, "libcosim") for c in COUPLINGS]
+    total, done = len(runs) * len(STEPS), 0
+    results = {}
+    for coupling, order in runs:
+        rows = []
+        for H in STEPS:
+            progress(done, total, f"{coupling}, {order}, H = {H:g}")
+            r = (cosimulate_libcosim(contact, striker, H, coupling) if order == "libcosim"
+                 else cosimulate(contact, striker, H, coupling, order))
+            rows.append(dict(H=H, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] - ref["eps"],
+                             energy_error=r["energy_error"]))
+            done += 1
+        results[(coupling, order)] = rows
+    progress(total, total, "traces")
+    traces = {(c, o): cosimulate(contact, striker, 1e-4, c, o, trace=True)["series"]
+              for c in COUPLINGS for o in ORDERS}
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    args.out.mkdir(parents=True, exist_ok=True)
+    plot(args.out / "cosimulation.png", results, traces)
+    write(args.out / "cosimulation.md", results, ref)
+    print((args.out / "cosimulation.md").read_text())
+
+
+def plot(path, results, traces):
+    fig, axes = plt.subplots(2, 2, figsize=(13, 9))
+    for (coupling, order), rows in results.items():
+        if order == "libcosim":
+            continue
+        style = "-" if coupling == "mass-aware" else "--"
+        label = f"{coupling}, {order}"
+        H = [r["H"] for r in rows]
+        for ax, key in zip(axes.flat[:3], ("F_peak_error", "eps_error", "energy_error")):
+            ax.loglog(H, [max(abs(r[key]), 1e-16) for r in rows], style, marker=".", label=label)
+    for (coupling, order), rows in results.items():
+        if order == "libcosim":
+            axes.flat[0].loglog([r["H"] for r in rows], [max(abs(r["F_peak_error"]), 1e-16) for r in rows], "kx",
+                                ms=4, label=f"{coupling}, libcosim (Jacobi)")
+    titles = ("|F_peak error| (relative)", "|eps error| (absolute)", "|energy error| (of the impact energy)")
+    for ax, title in zip(axes.flat[:3], titles):
+        ax.axhline(0.01, color="gray", lw=0.8)
+        ax.set(xlabel="communication step H [s]", title=title)
+        ax.grid(alpha=0.3, which="both")
+    axes.flat[0].legend(fontsize=8)
+    ax = axes.flat[3]
+    for (coupling, order), series in traces.items():
+        t, F = np.array([s[0] for s in series]), np.array([s[1] for s in series])
+        ax.step(t * 1e3, F, where="post", ls="-" if coupling == "mass-aware" else "--", label=f"{coupling}, {order}")
+    ax.set(xlabel="time [ms]", ylabel="contact force F [N]", title="Force at H = 0.1 ms")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.suptitle("Striker FMU + contact FMU against the monolithic drop test (h20)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100, metadata={"Software": None})
+
+
+def fmt_step(H):
+    return f"{H:g} s" if H is not None else "none in the ladder"
+
+
+def write(path, results, ref):
+    omega = np.sqrt(1.5 * K * ((5 * M * V0 ** 2 / (4 * K)) ** 0.4) ** 0.5 / M)
+    out = ["# Co-simulation: striker FMU + contact FMU", "",
+           "Regenerate: `scripts/report cosim_study` (about two minutes; writes this file and `cosimulation.png`). "
+           "The driver is `scripts/cosim.py` (fmpy's FMU API; also a command).", "",
+           "The paper's h20 drop test split in two FMUs: `striker.fmu` (a rigid body, m = 0.7437 kg, v0 = 0.626418 m/s, "
+           "no gravity) and `fraccontact.fmu` in its driven scene (Hertz law, dt_max = 1e-7 s), the striker's "
+           "velocity into the contact, the contact's force into the striker, for 3 ms. Against the monolithic "
+           f"drop test (the contact FMU alone: F_peak = {ref['F_peak']:.6g} N, eps = {ref['eps']:.6g}), for "
+           "communication steps H from 1e-6 s to 1e-3 s (31 steps, log-spaced).", "",
+           "- **zoh**: the contact holds the striker's velocity over the step (m = 0) and the striker holds the "
+           "contact force F of the last communication point;",
+           "- **mass-aware**: the contact runs a proxy striker of the same mass inside the step (m = 0.7437) and "
+           "the striker receives `F_avg`, the step's impulse divided by its length;",
+           "- **jacobi**: both FMUs step from the values of the last point; **gauss-seidel**: the contact steps "
+           "first and the striker takes its force of the same step.", "",
+           "The Jacobi runs were repeated in **libcosim** (Open Simulation Platform, `libcosimpy` from PyPI), whose "
+           "fixed-step algorithm is the Jacobi order: " + agreement(results) + ".", "",
+           "![co-simulation study](cosimulation.png)", "",
+           "## Largest communication step within 1 % of the monolithic F_peak", "",
+           "| coupling | order | largest H, F_peak within 1 % | within 1e-3 | energy created (> 1 %) from |",
+           "|---|---|---|---|---|"]
+    for (coupling, order), rows in results.items():
+        out.append(f"| {coupling} | {order} | {fmt_step(largest_step_within(rows, 'F_peak_error', 0.01))} | "
+                   f"{fmt_step(largest_step_within(rows, 'F_peak_error', 1e-3))} | {fmt_step(first_unstable(rows))} |")
+    out += ["", "## Why", "",
+            "- **Jacobi** applies to the striker the force of the previous point: the force lags the motion by one "
+            "step, which pumps energy into the contact (a delayed spring force does positive work over a cycle). "
+            "The error is first order in H: about 0.2 % of F_peak at H = 1e-6 s, 2 % at 1e-5 s. The mass-aware "
+            "proxy cannot help here, because the striker still receives last step's impulse.",
+            "- **Gauss-Seidel with a zero-order hold** is consistent (no lag in the force) but the contact is fed "
+            "a velocity held over the step while the striker decelerates: it over-indents, and the explicit "
+            "exchange of a stiff spring becomes unstable once H approaches the contact's own time scale: with the "
+            f"Hertz stiffness at peak indentation, 1/omega = {1 / omega:.2e} s.",
+            "- **Mass-aware Gauss-Seidel** is exact: the proxy striker inside the contact FMU is the striker (same "
+            "mass, no other force), and F_avg carries exactly the impulse the proxy exchanged, so the striker "
+            "ends the step with the proxy's velocity. The result equals the monolithic drop test to rounding "
+            "(1e-14) at every H up to 1e-3 s (`tests/test_cosim.py` holds it to 1e-9).", "",
+            "## Recommendations", "",
+            "- Give the contact FMU the striker's mass (`m`), connect `F_avg` (not `F`) to the striker, and step "
+            "the contact before the striker (Gauss-Seidel). Then the communication step is free: choose it for "
+            "the rest of the system; the contact FMU resolves the impact inside with `dt_max`.",
+            "- With a master that only does Jacobi (libcosim's fixed-step algorithm, many vendor tools), the lag "
+            "is the error: keep H below about 5e-6 s for 1 % in F_peak, or let the master roll back "
+            "(`canGetAndSetFMUstate`) and iterate the step.",
+            "- Other forces on the striker (gravity, springs) enter the proxy only through `v` at each point; "
+            "they are small against an impact force, and `g` can give the proxy gravity.", "",
+            "## Every run", "",
+            "| coupling | order | H [s] | F_peak error | eps error | energy error |", "|---|---|---|---|---|---|"]
+    for (coupling, order), rows in results.items():
+        for r in rows:
+            out.append(f"| {coupling} | {order} | {r['H']:g} | {r['F_peak_error']:.2e} | {r['eps_error']:.2e} | "
+                       f"{r['energy_error']:.2e} |")
+    path.write_text("\n".join(out) + "\n")
+
+
+def agreement(results):
+    worst = 0.0
+    for coupling in COUPLINGS:
+        for a, b in zip(results[(coupling, "jacobi")], results[(coupling, "libcosim")]):
+            for key in ("F_peak_error", "eps_error", "energy_error"):
+                worst = max(worst, abs(a[key] - b[key]))
+    return f"at every step and for both couplings its results match this driver's Jacobi runs within {worst:.1e}"
+
+
+if __name__ == "__main__":
+    main()
