@@ -19,12 +19,14 @@ C = 6080.0
 class Slave:
     """One instance of the FMU, set, read and stepped by variable name.
 
-    Log messages land in self.log as (status, category, message)."""
+    Log messages land in self.log as (status, category, message), the
+    instance names they carry in self.log_names."""
 
     def __init__(self, model_description, unzipped, start=True, **values):
         self.md = model_description
         self.variables = {v.name: v for v in model_description.modelVariables}
         self.log = []
+        self.log_names = []
         self.callbacks = fmi2CallbackFunctions()
         self.callbacks.logger = fmi2CallbackLoggerTYPE(self._logger)
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
@@ -42,6 +44,7 @@ class Slave:
 
     def _logger(self, env, name, status, category, message):
         self.log.append((status, category.decode(), message.decode()))
+        self.log_names.append(name.decode())
 
     def start(self):
         self.fmu.enterInitializationMode()

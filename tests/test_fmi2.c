@@ -224,6 +224,107 @@ static void test_logging(void)
     fmi2FreeInstance(c);
 }
 
+/* Every exported function: with no instance (an error, no crash), in a
+ * state it may not be called in (an error, nothing changes), and in order. */
+static void test_every_function(void)
+{
+    fmi2ValueReference vr_F = VR_F, vr_v = VR_v, vr_law = VR_law, vr_contact = VR_contact;
+    fmi2Real r = 0.0;
+    fmi2Integer i = 0, order = 1;
+    fmi2Boolean b = fmi2False;
+    fmi2String str = NULL;
+    fmi2Status status;
+    fmi2FMUstate state = NULL;
+    size_t size = 0;
+    fmi2Byte bytes[4096];
+    fmi2Component c;
+
+    /* No instance. */
+    CHECK(fmi2SetDebugLogging(NULL, fmi2True, 0, NULL) == fmi2Error, "NULL component");
+    CHECK(fmi2SetupExperiment(NULL, fmi2False, 0, 0, fmi2False, 0) == fmi2Error, "NULL component");
+    CHECK(fmi2EnterInitializationMode(NULL) == fmi2Error && fmi2ExitInitializationMode(NULL) == fmi2Error,
+          "NULL component");
+    CHECK(fmi2Terminate(NULL) == fmi2Error && fmi2Reset(NULL) == fmi2Error, "NULL component");
+    CHECK(fmi2GetReal(NULL, &vr_F, 1, &r) == fmi2Error && fmi2SetReal(NULL, &vr_v, 1, &r) == fmi2Error,
+          "NULL component");
+    CHECK(fmi2GetInteger(NULL, &vr_law, 1, &i) == fmi2Error && fmi2SetInteger(NULL, &vr_law, 1, &i) == fmi2Error,
+          "NULL component");
+    CHECK(fmi2GetBoolean(NULL, &vr_contact, 1, &b) == fmi2Error
+              && fmi2SetBoolean(NULL, &vr_contact, 1, &b) == fmi2Error, "NULL component");
+    CHECK(fmi2GetString(NULL, &vr_F, 1, &str) == fmi2Error && fmi2SetString(NULL, &vr_F, 1, &str) == fmi2Error,
+          "NULL component");
+    CHECK(fmi2GetFMUstate(NULL, &state) == fmi2Error && fmi2SetFMUstate(NULL, state) == fmi2Error
+              && fmi2FreeFMUstate(NULL, &state) == fmi2Error, "NULL component");
+    CHECK(fmi2SerializedFMUstateSize(NULL, state, &size) == fmi2Error
+              && fmi2SerializeFMUstate(NULL, state, bytes, sizeof bytes) == fmi2Error
+              && fmi2DeSerializeFMUstate(NULL, bytes, sizeof bytes, &state) == fmi2Error, "NULL component");
+    CHECK(fmi2GetDirectionalDerivative(NULL, &vr_F, 1, &vr_v, 1, &r, &r) == fmi2Error, "NULL component");
+    CHECK(fmi2SetRealInputDerivatives(NULL, &vr_v, 1, &order, &r) == fmi2Error
+              && fmi2GetRealOutputDerivatives(NULL, &vr_F, 1, &order, &r) == fmi2Error, "NULL component");
+    CHECK(fmi2DoStep(NULL, 0, 1e-5, fmi2True) == fmi2Error && fmi2CancelStep(NULL) == fmi2Error, "NULL component");
+    CHECK(fmi2GetStatus(NULL, fmi2DoStepStatus, &status) == fmi2Error
+              && fmi2GetRealStatus(NULL, fmi2LastSuccessfulTime, &r) == fmi2Error
+              && fmi2GetIntegerStatus(NULL, fmi2DoStepStatus, &i) == fmi2Error
+              && fmi2GetBooleanStatus(NULL, fmi2Terminated, &b) == fmi2Error
+              && fmi2GetStringStatus(NULL, fmi2PendingStatus, &str) == fmi2Error, "NULL component");
+    fmi2FreeInstance(NULL);
+
+    /* Instantiated: no outputs, no steps, no statuses yet. */
+    c = instantiate("every");
+    CHECK(fmi2GetReal(c, &vr_F, 1, &r) == fmi2Error && fmi2GetInteger(c, &vr_law, 1, &i) == fmi2Error
+              && fmi2GetBoolean(c, &vr_contact, 1, &b) == fmi2Error && fmi2GetString(c, &vr_F, 1, &str) == fmi2Error,
+          "getters before initialization");
+    CHECK(fmi2GetRealOutputDerivatives(c, &vr_F, 1, &order, &r) == fmi2Error, "output derivative too early");
+    CHECK(fmi2GetDirectionalDerivative(c, &vr_F, 1, &vr_v, 1, &r, &r) == fmi2Error, "directional derivative");
+    CHECK(fmi2GetStatus(c, fmi2DoStepStatus, &status) == fmi2Error
+              && fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &r) == fmi2Error
+              && fmi2GetIntegerStatus(c, fmi2DoStepStatus, &i) == fmi2Error
+              && fmi2GetBooleanStatus(c, fmi2Terminated, &b) == fmi2Error
+              && fmi2GetStringStatus(c, fmi2PendingStatus, &str) == fmi2Error, "statuses before stepping");
+    CHECK(fmi2ExitInitializationMode(c) == fmi2Error && fmi2Terminate(c) == fmi2Error, "exit, terminate early");
+
+    /* In order. */
+    CHECK(fmi2SetDebugLogging(c, fmi2False, 0, NULL) == fmi2OK, "logging");
+    CHECK(fmi2SetupExperiment(c, fmi2True, 1e-6, 0.0, fmi2True, 3e-3) == fmi2OK, "setup");
+    i = 2;
+    CHECK(fmi2SetInteger(c, &vr_law, 1, &i) == fmi2OK, "law");
+    CHECK(fmi2SetBoolean(c, &vr_contact, 1, &b) == fmi2Error, "a Boolean output cannot be set");
+    CHECK(fmi2SetString(c, NULL, 0, NULL) == fmi2OK && fmi2SetString(c, &vr_F, 1, &str) == fmi2Error,
+          "no strings");
+    CHECK(fmi2SetRealInputDerivatives(c, &vr_v, 1, &order, &r) == fmi2OK, "input derivative");
+    CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter");
+    CHECK(fmi2GetReal(c, &vr_v, 1, &r) == fmi2OK && fmi2GetInteger(c, &vr_law, 1, &i) == fmi2OK && i == 2
+              && fmi2GetBoolean(c, &vr_contact, 1, &b) == fmi2OK && b == fmi2False, "getters in initialization");
+    CHECK(fmi2ExitInitializationMode(c) == fmi2OK, "exit");
+    CHECK(fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) == fmi2Error
+              && fmi2EnterInitializationMode(c) == fmi2Error && fmi2ExitInitializationMode(c) == fmi2Error,
+          "initialization calls after initialization");
+    CHECK(fmi2DoStep(c, 0.0, 1e-4, fmi2False) == fmi2OK, "step");
+    CHECK(fmi2GetRealOutputDerivatives(c, &vr_F, 1, &order, &r) == fmi2OK && r > 0.0, "dF/dt while loading");
+    CHECK(fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &r) == fmi2OK && r == 1e-4, "last successful time");
+    CHECK(fmi2GetBooleanStatus(c, fmi2Terminated, &b) == fmi2OK && b == fmi2False, "terminated status");
+    CHECK(fmi2GetStatus(c, fmi2DoStepStatus, &status) == fmi2Discard
+              && fmi2GetIntegerStatus(c, fmi2DoStepStatus, &i) == fmi2Discard
+              && fmi2GetStringStatus(c, fmi2PendingStatus, &str) == fmi2Discard, "no asynchronous status");
+    CHECK(fmi2CancelStep(c) == fmi2Error, "nothing to cancel");
+    CHECK(fmi2GetFMUstate(c, &state) == fmi2OK, "get state");
+    CHECK(fmi2SerializedFMUstateSize(c, state, &size) == fmi2OK && size > 0 && size <= sizeof bytes, "state size");
+    CHECK(fmi2SerializeFMUstate(c, state, bytes, size - 1) == fmi2Error, "too small a buffer");
+    CHECK(fmi2SerializeFMUstate(c, state, bytes, size) == fmi2OK, "serialize");
+    CHECK(fmi2FreeFMUstate(c, &state) == fmi2OK && state == NULL, "free state");
+    CHECK(fmi2DeSerializeFMUstate(c, bytes, size, &state) == fmi2OK, "deserialize");
+    CHECK(fmi2DoStep(c, 1e-4, 1e-4, fmi2True) == fmi2OK && fmi2SetFMUstate(c, state) == fmi2OK
+              && fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &r) == fmi2OK && r == 1e-4, "roll back");
+    CHECK(fmi2FreeFMUstate(c, &state) == fmi2OK, "free state");
+    CHECK(fmi2Terminate(c) == fmi2OK, "terminate");
+    CHECK(fmi2DoStep(c, 1e-4, 1e-4, fmi2True) == fmi2Error && fmi2SetReal(c, &vr_v, 1, &r) == fmi2Error
+              && fmi2SetRealInputDerivatives(c, &vr_v, 1, &order, &r) == fmi2Error && fmi2Terminate(c) == fmi2Error,
+          "after terminate");
+    CHECK(fmi2GetReal(c, &vr_F, 1, &r) == fmi2OK, "outputs after terminate");
+    CHECK(fmi2Reset(c) == fmi2OK && fmi2GetReal(c, &vr_F, 1, &r) == fmi2Error, "reset: instantiated again");
+    fmi2FreeInstance(c);
+}
+
 int main(void)
 {
     test_instantiate();
@@ -232,5 +333,6 @@ int main(void)
     test_out_of_range();
     test_independent_instances();
     test_logging();
+    test_every_function();
     return check_summary("test_fmi2");
 }
