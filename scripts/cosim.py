@@ -113,7 +113,6 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
     """The same scene in libcosim (Open Simulation Platform, via libcosimpy):
     an independent FMI 2.0 importer. Its fixed-step algorithm steps every
     FMU from the last exchanged values: the Jacobi order."""
-    from libcosimpy.CosimEnums import CosimVariableType  # noqa: F401  (imported for its side effects' absence)
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver

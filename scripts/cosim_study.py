@@ -9,7 +9,6 @@ Regenerate: scripts/report cosim_study   (about two minutes)
 
 import argparse
 import pathlib
-import sys
 
 import numpy as np
 
@@ -18,15 +17,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from cosim import COUPLINGS, M, ORDERS, V0, cosimulate, cosimulate_libcosim, monolithic  # noqa: E402
+from progress import progress  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 STEPS = [float(f"{h:.3g}") for h in np.logspace(-6, -3, 31)]
 K = 3.299e8
 
-
-def progress(done, total, what):
-    if sys.stderr.isatty():
-        print(f"\r[{'#' * int(30 * done / total):<30}] {done}/{total} {what:<40}", end="", file=sys.stderr, flush=True)
 
 
 def largest_step_within(rows, key, bound):
@@ -68,11 +64,9 @@ def main():
                              energy_error=r["energy_error"]))
             done += 1
         results[(coupling, order)] = rows
-    progress(total, total, "traces")
     traces = {(c, o): cosimulate(contact, striker, 1e-4, c, o, trace=True)["series"]
               for c in COUPLINGS for o in ORDERS}
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
+    progress(total, total, "done")
     args.out.mkdir(parents=True, exist_ok=True)
     plot(args.out / "cosimulation.png", results, traces)
     write(args.out / "cosimulation.md", results, ref)

@@ -13,7 +13,6 @@ import json
 import math
 import pathlib
 import subprocess
-import sys
 import tempfile
 import time
 
@@ -23,6 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from progress import progress  # noqa: E402
 from scipy_contact import solve_drop  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -43,12 +43,6 @@ METHODS = [  # label, solver options
 SCIPY = ("LSODA", "DOP853", "Radau")
 TOLERANCES = [10.0 ** -e for e in range(3, 13)]
 
-
-def progress(done, total, what):
-    """A progress bar on a terminal; nothing in a log."""
-    if sys.stderr.isatty():
-        bar = "#" * int(30 * done / total)
-        print(f"\r[{bar:<30}] {done}/{total} {what:<50}", end="", file=sys.stderr, flush=True)
 
 
 def run(solver, *args):
@@ -149,7 +143,6 @@ def main():
                              **errors(r, force_on_grid(tmp / "gsl.csv"), ref, F_ref)))
         done += 1
     progress(total, total, "done")
-    print(file=sys.stderr)
 
     args.out.mkdir(parents=True, exist_ok=True)
     plot(args.out / "error_vs_runtime.png", results, scipy_rows, gsl_rows)

@@ -7,7 +7,6 @@ Regenerate: scripts/run   (or: .venv/bin/python scripts/h20_drop.py --help)
 
 import argparse
 import csv
-import math
 import pathlib
 
 import matplotlib

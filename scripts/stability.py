@@ -15,6 +15,8 @@ import pathlib
 import subprocess
 import sys
 
+from progress import progress
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE = dict(c=6080.0, E_s=2.64e9, v0=0.626418, m=0.7437, dt=1e-7, g1_nodes=0, gap0=0.0, g=0.0, impacts=1)
 R, E_I, NU_I, NU_S = 6.35e-3, 210e9, 0.3, 0.4
@@ -154,13 +156,10 @@ def main():
     cases = [(n, c) for n, c in matrix() if not args.fast or n in FAST]
     rows = []
     for i, (name, case) in enumerate(cases):
+        progress(i, len(cases), name)
         for law in ("g1", "hertz"):
-            if sys.stderr.isatty():
-                print(f"\r[{'#' * int(30 * i / len(cases)):<30}] {i}/{len(cases)} {name:<60}", end="",
-                      file=sys.stderr, flush=True)
             rows.append((name, case, check(args.solver, case, law)))
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
+    progress(len(cases), len(cases), "done")
     failed = [(n, r) for n, c, r in rows if r["failures"]]
     write_report(args.out / ("stability_fast.md" if args.fast else "stability.md"), rows, failed)
     print(f"{len(rows) - len(failed)} passed, {len(failed)} failed")

@@ -11,8 +11,6 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from fmu_driver import M
-
 
 def test_validate_fmu_finds_no_problem(fmu_path):
     assert validate_fmu(str(fmu_path)) == []
