@@ -56,6 +56,8 @@ static int reject(char *msg, size_t len, const char *name, double value, const c
 }
 
 static int positive(double x) { return isfinite(x) && x > 0.0; }
+/* Positive, finite, and not denormal: its reciprocal is finite too. */
+static int invertible(double x) { return isnormal(x) && x > 0.0; }
 static int nonnegative(double x) { return isfinite(x) && x >= 0.0; }
 static int poisson_ratio(double x) { return isfinite(x) && x > -1.0 && x <= 0.5; }
 
@@ -71,11 +73,16 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return reject(msg, len, "E_s", p->E_s, "Young's modulus must be positive and finite [Pa]");
     if (!poisson_ratio(p->nu_s))
         return reject(msg, len, "nu_s", p->nu_s, "a Poisson ratio must lie in (-1, 0.5]");
-    if (!nonnegative(p->k))
+    if (!(p->k == 0.0 || invertible(p->k)))
         return reject(msg, len, "k", p->k,
-                      "the Hertz constant must be finite and >= 0 (0 derives it from R, E_i, nu_i, E_s, nu_s) [N/m^1.5]");
-    if (!positive(p->c))
-        return reject(msg, len, "c", p->c, "the dashpot constant must be positive and finite [N s/m]");
+                      "the Hertz constant must be positive, finite and not denormal, or 0 to derive it from R, "
+                      "E_i, nu_i, E_s, nu_s [N/m^1.5]");
+    if (p->k == 0.0 && !invertible(hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s)))
+        return reject(msg, len, "k", p->k,
+                      "the Hertz constant derived from R, E_i, nu_i, E_s, nu_s is out of range (zero, denormal or "
+                      "infinite)");
+    if (!invertible(p->c))
+        return reject(msg, len, "c", p->c, "the dashpot constant must be positive, finite and not denormal [N s/m]");
     if (!positive(p->dt_max))
         return reject(msg, len, "dt_max", p->dt_max, "the largest internal step must be positive and finite [s]");
     if (!isfinite(p->g))
@@ -99,11 +106,12 @@ int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
 {
     if (!isfinite(v))
         return reject(msg, len, "v", v, "the striker velocity must be finite [m/s]");
-    if (scene == CONTACT_SCENE_DROP && !positive(m))
-        return reject(msg, len, "m", m, "the drop test's striker mass must be positive and finite [kg]");
-    if (!nonnegative(m))
+    if (scene == CONTACT_SCENE_DROP && !invertible(m))
+        return reject(msg, len, "m", m, "the drop test's striker mass must be positive, finite and not denormal [kg]");
+    if (!(m == 0.0 || invertible(m)))
         return reject(msg, len, "m", m,
-                      "the striker mass must be finite and >= 0 (0 in the driven scene: no striker inertia) [kg]");
+                      "the striker mass must be positive, finite and not denormal, or 0 in the driven scene (no "
+                      "striker inertia) [kg]");
     return 0;
 }
 
@@ -237,13 +245,22 @@ static double sdirk_step(const contact_model *cm, const contact_state *in, doubl
     return impulse;
 }
 
-/* Free flight is the parabola x1 + v t + accel t^2 / 2. The time in [0, h]
- * at which it enters the specimen, given that it has entered by h. */
-static double onset_time(double x1, double v, double a, double h)
+static void begin_contact(contact_state *s, double t, double v);
+
+/* Free flight is the parabola x1 + v t + a t^2 / 2 (x1 <= 0: the gap). The
+ * first time in [0, h] at which it enters the specimen, or -1 if it stays
+ * out: either it is inside at h, or a concave parabola (a < 0) peaks inside
+ * the specimen within the step and leaves again. */
+static double flight_onset(double x1, double v, double a, double h)
 {
     double A = 0.5 * a, disc, q, r1, r2, t;
     if (x1 >= 0.0 && (v > 0.0 || (v == 0.0 && a > 0.0)))
         return 0.0;
+    if (!(x1 + h * (v + A * h) > 0.0)) {
+        double vertex = a < 0.0 ? -v / a : -1.0;
+        if (!(vertex > 0.0 && vertex < h && x1 + vertex * (v + A * vertex) > 0.0))
+            return -1.0;
+    }
     if (A == 0.0)
         t = -x1 / v;
     else {
@@ -256,6 +273,20 @@ static double onset_time(double x1, double v, double a, double h)
         t = a > 0.0 ? fmax(r1, r2) : fmin(r1, r2);
     }
     return fmin(fmax(t, 0.0), h);
+}
+
+/* Free flight for tau, exact (the step with no spring), then contact begins
+ * if `touch`. */
+static void fly(contact_model *cm, double tau, int touch)
+{
+    contact_state trial;
+    sdirk_step(cm, &cm->s, tau, 0.0, &trial);
+    cm->s = trial;
+    if (touch) {
+        cm->s.x1 = 0.0;
+        cm->s.F = 0.0;
+        begin_contact(&cm->s, cm->s.t, cm->s.v);
+    }
 }
 
 /* What an event watches at the end of a trial step: the elastic indentation
@@ -361,17 +392,10 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse)
         double tau = h, K, J, peak;
         int separates;
         if (!s->in_contact) {
-            sdirk_step(cm, s, h, 0.0, &trial);
-            if (!(trial.x1 > 0.0)) {
-                *s = trial;
+            tau = flight_onset(s->x1, s->v, cm->accel, h);
+            fly(cm, tau < 0.0 ? h : tau, tau >= 0.0);
+            if (tau < 0.0)
                 return 0;
-            }
-            tau = onset_time(s->x1, s->v, cm->accel, h);
-            sdirk_step(cm, s, tau, 0.0, &trial);
-            *s = trial;
-            s->x1 = 0.0;
-            s->F = 0.0;
-            begin_contact(s, s->t, s->v);
             h -= tau;
             continue;
         }
@@ -450,19 +474,35 @@ int contact_state_is_finite(const contact_state *s)
 double contact_advance(contact_model *cm, double H)
 {
     const contact_state start = cm->s;
-    double steps, h, impulse = 0.0, i;
+    double remaining = H, impulse = 0.0;
     if (!(H > 0.0))
         return 0.0;
-    /* Round H/dt_max up, forgiving the last few ulp so that H = n dt_max
-     * gives n steps, not n + 1 with a sliver. */
-    steps = fmax(1.0, ceil(H / cm->p.dt_max * (1.0 - 1e-12)));
-    h = H / steps;
+    while (remaining > 0.0) {
+        double n, h, i;
+        if (!cm->s.in_contact && cm->p.scheme == CONTACT_SCHEME_SDIRK2) {
+            /* Free flight is exact at any length: one step to the onset, or
+             * over the whole rest when the striker does not arrive. */
+            double tau = flight_onset(cm->s.x1, cm->s.v, cm->accel, remaining);
+            cm->s.steps++;
+            fly(cm, tau < 0.0 ? remaining : tau, tau >= 0.0);
+            remaining = tau < 0.0 ? 0.0 : remaining - tau;
+            continue;
+        }
+        /* In contact: equal steps of at most dt_max over the rest, rounding
+         * n up but forgiving the last few ulp (H = n dt_max gives n steps,
+         * not n + 1 with a sliver), until the contact ends. */
+        n = fmax(1.0, ceil(remaining / cm->p.dt_max * (1.0 - 1e-12)));
+        h = remaining / n;
+        for (i = 0; i < n && (cm->s.in_contact || cm->p.scheme == CONTACT_SCHEME_CENTRAL); i++)
+            if (internal_step(cm, h, &impulse) != 0) {
+                cm->s = start;
+                return NAN;
+            }
+        remaining = i < n ? remaining - i * h : 0.0;
+    }
     /* A non-finite value stays non-finite through the steps that follow
      * (and bounds their event searches), so one check at the end suffices. */
-    for (i = 0; i < steps; i++)
-        if (internal_step(cm, h, &impulse) != 0)
-            break;
-    if (i < steps || !contact_state_is_finite(&cm->s)) {
+    if (!contact_state_is_finite(&cm->s)) {
         cm->s = start;
         return NAN;
     }
