@@ -83,8 +83,9 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
                       "infinite)");
     if (!invertible(p->c))
         return reject(msg, len, "c", p->c, "the dashpot constant must be positive, finite and not denormal [N s/m]");
-    if (!positive(p->dt_max))
-        return reject(msg, len, "dt_max", p->dt_max, "the largest internal step must be positive and finite [s]");
+    if (!invertible(p->dt_max))
+        return reject(msg, len, "dt_max", p->dt_max,
+                      "the largest internal step must be positive, finite and not denormal [s]");
     if (!isfinite(p->g))
         return reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
     if (!nonnegative(p->gap0))

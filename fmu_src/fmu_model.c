@@ -270,9 +270,10 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
         return report(fm, FM_ERROR, "logStatusError",
                       "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g",
                       t, cm->s.t);
-    if (H / fm->params.dt_max > 1e12)
+    /* About a minute of CPU: beyond that a step is a mistake, not a wish. */
+    if (H / fm->params.dt_max > 1e9)
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2DoStep: communicationStepSize = %g would take more than 1e12 internal steps "
+                      "fmi2DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
                       "of dt_max = %g; take shorter communication steps or a larger dt_max", H, fm->params.dt_max);
     cm->s.t = t;
     if (H == 0.0)

@@ -82,7 +82,7 @@ static void test_call_sequence(void)
     CHECK(fmi2DoStep(c, 0.0, 1e-5, fmi2True) == fmi2OK, "a step");
     expect_error(fmi2DoStep(c, 0.5, 1e-5, fmi2True), "currentCommunicationPoint", "0.5", "time mismatch");
     expect_error(fmi2DoStep(c, 1e-5, -1.0, fmi2True), "communicationStepSize", "-1", "negative step");
-    expect_error(fmi2DoStep(c, 1e-5, 1e9, fmi2True), "communicationStepSize", "1e12", "endless step");
+    expect_error(fmi2DoStep(c, 1e-5, 1e9, fmi2True), "communicationStepSize", "1e9", "endless step");
     CHECK(fmi2DoStep(c, 1e-5, 1e-5, fmi2True) == fmi2OK, "the instance is still usable: %s", last_message);
     expect_error(fmi2CancelStep(c), "fmi2CancelStep", NULL, "cancel without a pending step");
     CHECK(fmi2Terminate(c) == fmi2OK, "terminate");

@@ -1,0 +1,278 @@
+/* Fuzzing the FMI API: a byte string read as a program of FMI calls with
+ * their values, on two instances at once. After every call: the status is
+ * one the standard allows (never fmi2Fatal or fmi2Pending from a synchronous
+ * slave), and whenever outputs can be read they are finite with F >= 0.
+ * A broken invariant aborts, which the fuzzer (libFuzzer, or the replay
+ * driver fuzz_replay.c in every other build) reports as a crash.
+ *
+ * The program: each call takes an opcode byte and then the bytes its
+ * arguments need; a value byte picks from a table of interesting numbers or,
+ * with its top bit set, reads the next 8 bytes as a raw double (NaN, Inf,
+ * denormals and all). Running out of bytes ends the program. */
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "guid.h"
+
+typedef struct {
+    const uint8_t *at, *end;
+} program;
+
+static int more(const program *p, size_t n)
+{
+    return (size_t)(p->end - p->at) >= n;
+}
+
+static uint8_t byte(program *p)
+{
+    return more(p, 1) ? *p->at++ : 0;
+}
+
+static const double interesting[] = {0.0, -0.0, 1.0, -1.0, 0.5, 1e-7, 1e-5, 1e-4, 1e-3, 3e-3, 1.0,
+                                     0.626418, 0.7437, 3.299e8, 6080.0, 6.35e-3, 2.64e9, 210e9, 0.3, 0.4,
+                                     9.81, 1e-15, 1e3, 1e300, -1e300, 5e-324, 2.2250738585072014e-308};
+
+static double value(program *p)
+{
+    uint8_t b = byte(p);
+    if (b & 0x80 && more(p, 8)) {
+        double d;
+        memcpy(&d, p->at, 8);
+        p->at += 8;
+        return d;
+    }
+    return interesting[b % (sizeof interesting / sizeof interesting[0])];
+}
+
+/* Value references: the FMU's (1..40) most of the time, anything else too. */
+static fmi2ValueReference reference(program *p)
+{
+    static const fmi2ValueReference known[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17,
+                                               18, 19, 20, 21, 22, 30, 31, 32, 40, 0, 99, 0xFFFFFFFFu};
+    return known[byte(p) % (sizeof known / sizeof known[0])];
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                   fmi2String message, ...)
+{
+    char text[2048];
+    va_list args;
+    (void)env;
+    (void)name;
+    (void)status;
+    (void)category;
+    va_start(args, message);
+    vsnprintf(text, sizeof text, message, args);
+    va_end(args);
+}
+
+static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+
+static void require(int ok, const char *what)
+{
+    if (!ok) {
+        fprintf(stderr, "fuzz invariant broken: %s\n", what);
+        abort();
+    }
+}
+
+static fmi2Status checked(fmi2Status s)
+{
+    require(s == fmi2OK || s == fmi2Warning || s == fmi2Discard || s == fmi2Error, "status outside the standard's");
+    return s;
+}
+
+/* Every real output, when readable, is finite and the force is not tension. */
+static void check_outputs(fmi2Component c)
+{
+    static const fmi2ValueReference outputs[] = {13, 14, 15, 16, 17, 18, 19, 20, 21, 22};
+    fmi2Real v[10];
+    size_t i;
+    if (checked(fmi2GetReal(c, outputs, 10, v)) != fmi2OK)
+        return;
+    for (i = 0; i < 10; i++)
+        require(v[i] - v[i] == 0.0, "a non-finite output");
+    require(v[0] >= 0.0 && v[2] >= 0.0, "a negative contact force");
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    program p = {data, data + size};
+    fmi2Component c[2] = {NULL, NULL};
+    fmi2FMUstate state[2] = {NULL, NULL};
+    fmi2Byte blob[4096];
+    size_t blob_size = 0;
+    int steps = 0;
+    while (more(&p, 1) && steps < 64) {
+        uint8_t op = byte(&p);
+        int k = op >> 7;                       /* which instance */
+        fmi2Component x = c[k];
+        fmi2ValueReference vr = 0;
+        fmi2Real r = 0.0, t = 0.0;
+        fmi2Integer n = 0, order = 1;
+        fmi2Boolean b = fmi2False;
+        fmi2Status s;
+        switch (op & 0x1F) {
+        case 0:
+            if (!x)
+                c[k] = fmi2Instantiate(k ? "b" : "a", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False,
+                                       byte(&p) & 1);
+            break;
+        case 1:
+            fmi2FreeInstance(x);
+            c[k] = NULL;
+            break;
+        case 2:
+            r = value(&p);
+            checked(fmi2SetupExperiment(x, fmi2False, 0.0, r, fmi2False, 0.0));
+            break;
+        case 3:
+            checked(fmi2EnterInitializationMode(x));
+            break;
+        case 4:
+            checked(fmi2ExitInitializationMode(x));
+            break;
+        case 5:
+            checked(fmi2Terminate(x));
+            break;
+        case 6:
+            checked(fmi2Reset(x));
+            break;
+        case 7:
+            vr = reference(&p);
+            r = value(&p);
+            checked(fmi2SetReal(x, &vr, 1, &r));
+            break;
+        case 8:
+            vr = reference(&p);
+            n = (fmi2Integer)(int8_t)byte(&p);
+            checked(fmi2SetInteger(x, &vr, 1, &n));
+            break;
+        case 9:
+            vr = reference(&p);
+            b = byte(&p) & 1;
+            checked(fmi2SetBoolean(x, &vr, 1, &b));
+            break;
+        case 10:
+            if (x)
+                check_outputs(x);
+            break;
+        case 11: /* a step from the last successful time, or from anywhere */
+            if (!x)
+                break;
+            r = value(&p);
+            /* Keep each input quick (long runs are the soak's): at most 1e-4 s
+             * and 1e4 internal steps a call. */
+            vr = 10;
+            if (checked(fmi2GetReal(x, &vr, 1, &t)) == fmi2OK && r > 1e4 * t)
+                r = 1e4 * t;
+            if (r > 1e-4)
+                r = 1e-4;
+            if (checked(fmi2GetRealStatus(x, fmi2LastSuccessfulTime, &t)) != fmi2OK || (byte(&p) & 1))
+                t = value(&p);
+            steps++;
+            s = checked(fmi2DoStep(x, t, r, fmi2True));
+            if (s == fmi2OK)
+                check_outputs(x);
+            break;
+        case 12:
+            if (x && !state[k])
+                checked(fmi2GetFMUstate(x, &state[k]));
+            break;
+        case 13: {
+            int j = byte(&p) & 1;
+            if (state[j])
+                checked(fmi2SetFMUstate(x, state[j]));
+            if (x)
+                check_outputs(x);
+            break;
+        }
+        case 14:
+            if (x) {
+                int j = byte(&p) & 1;
+                checked(fmi2FreeFMUstate(x, &state[j]));
+            }
+            break;
+        case 15:
+            if (x && state[k] && checked(fmi2SerializedFMUstateSize(x, state[k], &blob_size)) == fmi2OK
+                && blob_size <= sizeof blob)
+                checked(fmi2SerializeFMUstate(x, state[k], blob, blob_size));
+            break;
+        case 16: /* deserialize the blob, maybe mutated or cut short */
+            if (x && blob_size > 0) {
+                size_t at = byte(&p) % blob_size, length = blob_size;
+                fmi2Byte mutated[4096];
+                memcpy(mutated, blob, blob_size);
+                mutated[at] ^= byte(&p);
+                if (byte(&p) & 1)
+                    length = at;
+                if (!state[1]) {
+                    s = checked(fmi2DeSerializeFMUstate(x, mutated, length, &state[1]));
+                    if (s == fmi2OK) {
+                        checked(fmi2SetFMUstate(x, state[1]));
+                        check_outputs(x);
+                    }
+                }
+            }
+            break;
+        case 17:
+            vr = reference(&p);
+            order = (fmi2Integer)(byte(&p) % 4);
+            r = value(&p);
+            checked(fmi2SetRealInputDerivatives(x, &vr, 1, &order, &r));
+            break;
+        case 18:
+            vr = reference(&p);
+            order = (fmi2Integer)(byte(&p) % 3);
+            if (checked(fmi2GetRealOutputDerivatives(x, &vr, 1, &order, &r)) == fmi2OK)
+                require(r - r == 0.0, "a non-finite output derivative");
+            break;
+        case 19: {
+            const char *categories[] = {"logEvents", "logCalls", "logStatusError", "no such category"};
+            checked(fmi2SetDebugLogging(x, byte(&p) & 1, byte(&p) % 5, categories));
+            break;
+        }
+        case 20: {
+            fmi2String str = "x";
+            vr = reference(&p);
+            checked(byte(&p) & 1 ? fmi2SetString(x, &vr, 1, &str) : fmi2GetString(x, &vr, 1, &str));
+            break;
+        }
+        case 21: {
+            fmi2Status status;
+            fmi2String str;
+            checked(fmi2CancelStep(x));
+            checked(fmi2GetStatus(x, fmi2DoStepStatus, &status));
+            checked(fmi2GetIntegerStatus(x, fmi2DoStepStatus, &n));
+            checked(fmi2GetBooleanStatus(x, fmi2Terminated, &b));
+            checked(fmi2GetStringStatus(x, fmi2PendingStatus, &str));
+            break;
+        }
+        case 22:
+            vr = reference(&p);
+            if (checked(fmi2GetInteger(x, &vr, 1, &n)) == fmi2OK && vr == 30)
+                require(n >= 1 && n <= 3, "law out of its range");
+            if (checked(fmi2GetBoolean(x, &vr, 1, &b)) == fmi2OK)
+                require(b == fmi2True || b == fmi2False, "a Boolean neither true nor false");
+            break;
+        default:
+            checked(fmi2GetDirectionalDerivative(x, &vr, 1, &vr, 1, &r, &t));
+            break;
+        }
+    }
+    for (int k = 0; k < 2; k++) {
+        if (c[k]) {
+            fmi2FreeFMUstate(c[k], &state[0]);
+            fmi2FreeFMUstate(c[k], &state[1]);
+        }
+    }
+    free(state[0]); /* states outlive an instance freed before them */
+    free(state[1]);
+    fmi2FreeInstance(c[0]);
+    fmi2FreeInstance(c[1]);
+    return 0;
+}
