@@ -23,6 +23,7 @@ import time
 import numpy as np
 from scipy.special import gamma
 
+import atomic
 import differint.differint as differint
 from scipy_contact import solve_drop
 
@@ -206,7 +207,7 @@ def write(path, steps, impacts, g1, alpha):
             "point counts as off). `GLpoint` scales by (N+1)/(b-a) where the grid's step is (b-a)/N, an O(1/N) "
             "error. Ours is compiled and O(N) at the newest point; over the full grid it pays for the padding and "
             "the direct head but is right at every point."]
-    path.write_text("\n".join(out) + "\n")
+    atomic.write_text(path, "\n".join(out) + "\n")
 
 
 def main():

@@ -17,6 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from cosim import COUPLINGS, M, ORDERS, V0, cosimulate, cosimulate_libcosim, monolithic  # noqa: E402
+import atomic  # noqa: E402
 from progress import progress  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -102,7 +103,7 @@ def plot(path, results, traces):
     ax.legend(fontsize=8)
     fig.suptitle("Striker FMU + contact FMU against the monolithic drop test (h20)")
     fig.tight_layout()
-    fig.savefig(path, dpi=100, metadata={"Software": None})
+    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
 
 
 def fmt_step(H):
@@ -164,7 +165,7 @@ def write(path, results, ref):
         for r in rows:
             out.append(f"| {coupling} | {order} | {r['H']:g} | {r['F_peak_error']:.2e} | {r['eps_error']:.2e} | "
                        f"{r['energy_error']:.2e} |")
-    path.write_text("\n".join(out) + "\n")
+    atomic.write_text(path, "\n".join(out) + "\n")
 
 
 def agreement(results):

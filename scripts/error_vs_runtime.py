@@ -22,6 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import atomic  # noqa: E402
 from progress import progress  # noqa: E402
 from scipy_contact import solve_drop  # noqa: E402
 
@@ -173,7 +174,7 @@ def plot(path, results, scipy_rows, gsl_rows):
     axes.flat[-1].legend(handles, labels, loc="center", fontsize=9)
     fig.suptitle("Error against CPU time, h20 drop test (internal steps 1e-5 s ... 1.2e-9 s; gray line: 1e-6)")
     fig.tight_layout()
-    fig.savefig(path, dpi=100, metadata={"Software": None})
+    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
 
 
 def fmt(x):
@@ -248,7 +249,7 @@ def write_report(path, results, scipy_rows, gsl_rows, ref):
         for r in rows:
             out.append(f"| {label} | {r['dt']:.3g} | {r['steps']} | {r['cpu'] * 1e6:.1f} us | "
                        + " | ".join(fmt(r[m]) for m in METRICS) + " |")
-    path.write_text("\n".join(out) + "\n")
+    atomic.write_text(path, "\n".join(out) + "\n")
 
 
 if __name__ == "__main__":

@@ -14,6 +14,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from fmpy import simulate_fmu  # noqa: E402
 
+import atomic  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
@@ -48,7 +50,7 @@ def print_table(figures):
 
 
 def write_csv(path, results):
-    with open(path, "w", newline="") as f:
+    with atomic.replacing(path, newline="") as f:
         w = csv.writer(f)
         w.writerow(["time_s"] + [f"{n}_law{law}" for law in results for n in ("F_N", "x_m", "x1_m", "x2_m")])
         first = next(iter(results.values()))
@@ -81,7 +83,7 @@ def plot(path, results, figures):
         ax.legend(fontsize=8)
     fig.suptitle("h20 drop test: m = 0.7437 kg, v0 = 0.626 m/s, k = 3.299e8 N/m^1.5, c = 6080 N s/m")
     fig.tight_layout()
-    fig.savefig(path, dpi=110, metadata={"Software": None})
+    atomic.save_figure(fig, path, dpi=110, metadata={"Software": None})
 
 
 def main():

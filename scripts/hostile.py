@@ -17,6 +17,7 @@ import pathlib
 import subprocess
 import sys
 
+import atomic
 from progress import progress
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -25,50 +26,52 @@ VALUES = {"0": 0.0, "negative": -1.0, "denormal": 5e-324, "huge": 1e300, "NaN": 
           "-Inf": -math.inf}
 OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
 
-# One case, run in a child process: set values, initialize, step, check.
-CHILD = r'''
-import json, math, sys
-sys.path.insert(0, sys.argv[1])
-from fmpy import extract, read_model_description
-from fmpy.fmi1 import FMICallException
-from fmu_driver import Slave
-case = json.loads(sys.argv[3])
-md = read_model_description(sys.argv[2])
-s = Slave(md, extract(sys.argv[2]), start=False)
-s.enter()
-out = dict(stage="set")
-def finish(**kw):
-    out.update(kw)
-    errors = [m for st, c, m in s.log if st >= 3]
+def run_case_in(s, case):
+    """Runs one case on s, a fresh instance not yet in initialization mode
+    (tests/fmu_driver.Slave); returns its outcome and the last error message."""
+    from fmpy.fmi1 import FMICallException
+    out = dict(result="ran")
+    try:
+        s.enter()
+        out["result"] = "refused when set"
+        for name, value in case.get("values", {}).items():
+            s.set(**{name: value})
+        out["result"] = "refused at initialization"
+        s.fmu.exitInitializationMode()
+        out["result"] = "error in a step"
+        for kind, arg in case.get("steps", [["step", 1e-5]] * 200):
+            if kind == "step":
+                s.step(arg)
+            elif kind == "at":                  # a step from the wrong time
+                s.fmu.doStep(currentCommunicationPoint=arg, communicationStepSize=1e-5)
+            else:
+                s.set(**arg)
+            values = [s.get(n) for n in OUTPUTS]
+            if not all(math.isfinite(v) for v in values):
+                out.update(result="NON-FINITE OUTPUT", values=values)
+                break
+            if s.get("F") < 0:
+                out["result"] = "TENSION"
+                break
+        else:
+            out.update(result="ran", F_peak=s.get("F_peak"), eps=s.get("eps"))
+    except FMICallException:
+        pass
+    errors = [m for status, category, m in s.log if status >= 3]
     out["message"] = errors[-1] if errors else ""
-    print(json.dumps(out)); sys.exit(0)
-try:
-    for name, value in case.get("values", {}).items():
-        s.set(**{name: value})
-except FMICallException:
-    finish(result="refused when set")
-try:
-    s.fmu.exitInitializationMode()
-except FMICallException:
-    finish(result="refused at initialization")
-out["stage"] = "step"
-try:
-    for kind, arg in case.get("steps", [["step", 1e-5]] * 200):
-        if kind == "step":
-            s.step(arg)
-        elif kind == "at":                      # a step from the wrong time
-            s.fmu.doStep(currentCommunicationPoint=arg, communicationStepSize=1e-5)
-        elif kind == "set":
-            s.set(**arg)
-        values = [s.get(n) for n in %s]
-        if not all(math.isfinite(v) for v in values):
-            finish(result="NON-FINITE OUTPUT", values=values)
-        if s.get("F") < 0:
-            finish(result="TENSION")
-except FMICallException:
-    finish(result="error in a step")
-finish(result="ran", F_peak=s.get("F_peak"), eps=s.get("eps"))
-''' % OUTPUTS
+    return out
+
+
+# One case in a child process of its own, so that a crash is a finding.
+CHILD = r'''
+import json, sys
+sys.path[:0] = [sys.argv[1], sys.argv[2]]
+from fmpy import extract, read_model_description
+from fmu_driver import Slave
+from hostile import run_case_in
+md = read_model_description(sys.argv[3])
+print(json.dumps(run_case_in(Slave(md, extract(sys.argv[3]), start=False), json.loads(sys.argv[4]))))
+'''
 
 
 def cases():
@@ -93,7 +96,8 @@ def cases():
 
 def run_case(fmu, case):
     try:
-        done = subprocess.run([sys.executable, "-c", CHILD, str(ROOT / "tests"), str(fmu), json.dumps(case)],
+        done = subprocess.run([sys.executable, "-c", CHILD, str(ROOT / "tests"), str(ROOT / "scripts"), str(fmu),
+                               json.dumps(case)],
                               capture_output=True, text=True, timeout=300)
     except subprocess.TimeoutExpired:
         return dict(result="HANG (over 300 s)", message="")
@@ -131,7 +135,7 @@ def main():
         detail = str(detail).replace("|", "/")
         out.append(f"| {name} | {r['result']}{'' if acceptable(r) else ' (FAIL)'} | {detail} |")
     args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "reliability_hostile.md").write_text("\n".join(out) + "\n")
+    atomic.write_text((args.out / "reliability_hostile.md"), "\n".join(out) + "\n")
     print(f"{len(rows) - len(bad)} passed, {len(bad)} failed")
     for name, r in bad:
         print(f"FAILED {name}: {r}")

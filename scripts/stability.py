@@ -15,6 +15,7 @@ import pathlib
 import subprocess
 import sys
 
+import atomic
 from progress import progress
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -198,7 +199,7 @@ def write_report(path, rows, failed):
         out.append(f"| {name} | {r['law']} | {r['t_c']:.3g} | {f('steps', 'd')} | {f('impacts', 'd')} | "
                    f"{f('F_peak')} | {f('eps')} | {f('x_perm')} | {f('energy', '.1e')} | {f('momentum', '.1e')} | "
                    f"{f('reference', '.1e')} | {'FAIL' if r['failures'] else 'pass'} |")
-    path.write_text("\n".join(out) + "\n")
+    atomic.write_text(path, "\n".join(out) + "\n")
 
 
 if __name__ == "__main__":
