@@ -217,18 +217,25 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
         return FM_ERROR;
     contact_rates(cm, &x1_rate, &v_rate, &F_rate);
     switch (vr) {
-    case VR_F: *value = F_rate; return FM_OK;
-    case VR_x: *value = cm->s.v; return FM_OK;
-    case VR_x1: *value = x1_rate; return FM_OK;
-    case VR_x2: *value = cm->s.F * cm->inv_c; return FM_OK;
-    case VR_v_striker: *value = v_rate; return FM_OK;
-    case VR_E_diss: *value = cm->s.F * cm->s.F * cm->inv_c; return FM_OK;
-    case VR_semi_integral: *value = F_rate * contact_semi_integral_per_force(cm); return FM_OK;
+    case VR_F: *value = F_rate; break;
+    case VR_x: *value = cm->s.v; break;
+    case VR_x1: *value = x1_rate; break;
+    case VR_x2: *value = cm->s.F * cm->inv_c; break;
+    case VR_v_striker: *value = v_rate; break;
+    case VR_E_diss: *value = cm->s.F * cm->s.F * cm->inv_c; break;
+    case VR_semi_integral: *value = F_rate * contact_semi_integral_per_force(cm); break;
     default:
         return report(fm, FM_ERROR, "logStatusError",
                       "fmi2GetRealOutputDerivatives: value reference %u has no time derivative here "
                       "(F, x, x1, x2, v_striker, E_diss, semi_integral have)", vr);
     }
+    /* Extreme but valid states (k near DBL_MAX, say) can overflow a rate
+     * that the state itself does not. */
+    if (!isfinite(*value))
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2GetRealOutputDerivatives: the time derivative of value reference %u overflows (%g)", vr,
+                      *value);
+    return FM_OK;
 }
 
 fm_status fm_start(fmu_model *fm, double t0)
