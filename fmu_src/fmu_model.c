@@ -147,6 +147,18 @@ static double real_output(const fmu_model *fm, unsigned vr)
     }
 }
 
+/* The first real output whose value is not finite (a finite state can
+ * still overflow a derived output, such as x1 + x2), or NULL. */
+static const fmu_variable *nonfinite_output(const fmu_model *fm)
+{
+    size_t i;
+    for (i = 0; i < variables.count; i++)
+        if (variables.list[i].type == VAR_REAL && variables.list[i].causality == VAR_OUTPUT
+            && !isfinite(real_output(fm, variables.list[i].vr)))
+            return &variables.list[i];
+    return NULL;
+}
+
 fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
 {
     const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
@@ -266,7 +278,8 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
 {
     contact_model *cm = &fm->model;
     contact_state before;
-    double impulse;
+    double impulse, F_avg = fm->F_avg;
+    const fmu_variable *overflow;
     if (!isfinite(t) || !isfinite(H) || H < 0.0)
         return report(fm, FM_ERROR, "logStatusError",
                       "fmi2DoStep: currentCommunicationPoint = %.17g, communicationStepSize = %.17g: "
@@ -293,6 +306,15 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
                       "fmi2DoStep: the state became non-finite in [%.17g, %.17g] s; "
                       "it is kept at the start of the step", t, t + H);
     fm->F_avg = impulse / H;
+    overflow = nonfinite_output(fm);
+    if (overflow) {
+        double value = real_output(fm, overflow->vr);
+        cm->s = before;
+        fm->F_avg = F_avg;
+        return report(fm, FM_ERROR, "logStatusError",
+                      "fmi2DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
+                      "the state is kept at the start of the step", overflow->name, value, t, t + H);
+    }
     report_events(fm, &before);
     return FM_OK;
 }
@@ -341,6 +363,9 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1))
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
     contact_configure(&trial.model, &trial.params);
+    if (nonfinite_output(&trial))
+        return report(fm, FM_ERROR, "logStatusError", "the FMU state gives the output %s a non-finite value",
+                      nonfinite_output(&trial)->name);
     *fm = trial;
     return FM_OK;
 }
