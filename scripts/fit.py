@@ -14,6 +14,7 @@ import argparse
 import csv
 import json
 import math
+import os
 import pathlib
 import subprocess
 import sys
@@ -23,7 +24,7 @@ import numpy as np
 from scipy.optimize import brentq, least_squares
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SOLVER = ROOT / "build" / "fraccontact-solve"
+SOLVER = pathlib.Path(os.environ.get("FRACCONTACT_SOLVE", ROOT / "build" / "fraccontact-solve"))
 G = 9.81
 
 
