@@ -2,36 +2,41 @@
 
 #include <string.h>
 
-void serial_put_u32(unsigned char *at, uint32_t value)
+/* n bytes of value, least significant first; and back. */
+static void put_le(unsigned char *at, uint64_t value, int n)
 {
     int i;
-    for (i = 0; i < 4; i++)
+    for (i = 0; i < n; i++)
         at[i] = (unsigned char)(value >> (8 * i));
+}
+
+static uint64_t get_le(const unsigned char *at, int n)
+{
+    uint64_t value = 0;
+    int i;
+    for (i = 0; i < n; i++)
+        value |= (uint64_t)at[i] << (8 * i);
+    return value;
+}
+
+void serial_put_u32(unsigned char *at, uint32_t value)
+{
+    put_le(at, value, 4);
 }
 
 uint32_t serial_get_u32(const unsigned char *at)
 {
-    uint32_t value = 0;
-    int i;
-    for (i = 0; i < 4; i++)
-        value |= (uint32_t)at[i] << (8 * i);
-    return value;
+    return (uint32_t)get_le(at, 4);
 }
 
 void serial_put_u64(unsigned char *at, uint64_t value)
 {
-    int i;
-    for (i = 0; i < 8; i++)
-        at[i] = (unsigned char)(value >> (8 * i));
+    put_le(at, value, 8);
 }
 
 uint64_t serial_get_u64(const unsigned char *at)
 {
-    uint64_t value = 0;
-    int i;
-    for (i = 0; i < 8; i++)
-        value |= (uint64_t)at[i] << (8 * i);
-    return value;
+    return get_le(at, 8);
 }
 
 void serial_put_double(unsigned char *at, double value)
