@@ -79,6 +79,7 @@ static void usage(FILE *out)
             "h20 drop test. Options take a value as '--opt VALUE' or '--opt=VALUE'.\n\n");
     for (i = 0; i < N_OPTIONS; i++)
         fprintf(out, "  %-18s %s\n", table[i].name, table[i].help);
+    fprintf(out, "  %-18s %s\n", "--list-options", "print this table as JSON (option, kind, help, choices) and exit");
     fprintf(out, "  %-18s %s\n\n", "--help", "this text");
     fprintf(out,
             "Output (table, or --json keys): F_peak [N], eps, t_contact [s], x_perm [m], E_diss [J],\n"
@@ -87,6 +88,49 @@ static void usage(FILE *out)
             "steps (internal steps; the reference: right-hand-side evaluations), cpu_seconds (of the\n"
             "solve alone), impacts, separated, t_end [s] (where the solve stopped).\n"
             "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
+}
+
+static const char *const law_words[] = {"g1", "hertz", "g1x", NULL};
+static const char *const scheme_words[] = {"sdirk2", "central", NULL};
+static const char *const scene_words[] = {"drop", "driven", NULL};
+
+static void print_json_string(const char *text)
+{
+    putchar('"');
+    for (; *text; text++) {
+        if (*text == '"' || *text == '\\')
+            putchar('\\');
+        putchar(*text);
+    }
+    putchar('"');
+}
+
+/* The option table as JSON, for programs that drive the solver (the sweep):
+ * one table, never a copy of it. */
+static void list_options(void)
+{
+    static const char *const kinds[] = {"real", "integer", "word", "word", "word", "text", "flag"};
+    size_t i;
+    printf("[");
+    for (i = 0; i < N_OPTIONS; i++) {
+        const char *const *words = table[i].kind == LAW      ? law_words
+                                   : table[i].kind == SCHEME ? scheme_words
+                                   : table[i].kind == SCENE  ? scene_words
+                                                             : NULL;
+        printf("%s\n {\"option\": ", i ? "," : "");
+        print_json_string(table[i].name);
+        printf(", \"kind\": \"%s\", \"help\": ", kinds[table[i].kind]);
+        print_json_string(table[i].help);
+        if (words) {
+            int w;
+            printf(", \"choices\": [");
+            for (w = 0; words[w]; w++)
+                printf("%s\"%s\"", w ? ", " : "", words[w]);
+            printf("]");
+        }
+        printf("}");
+    }
+    printf("\n]\n");
 }
 
 static int bad_option(const char *name, const char *value, const char *why)
@@ -114,9 +158,6 @@ static int parse_word(const char *value, const char *const words[], int *out)
 
 static int set_option(options *o, const option *opt, const char *value)
 {
-    static const char *const laws[] = {"g1", "hertz", "g1x", NULL};
-    static const char *const schemes[] = {"sdirk2", "central", NULL};
-    static const char *const scenes[] = {"drop", "driven", NULL};
     char *at = (char *)o + opt->offset, *end;
     switch (opt->kind) {
     case REAL:
@@ -134,11 +175,11 @@ static int set_option(options *o, const option *opt, const char *value)
         return 0;
     }
     case LAW:
-        return parse_word(value, laws, (int *)at) ? bad_option(opt->name, value, "one of g1, hertz, g1x") : 0;
+        return parse_word(value, law_words, (int *)at) ? bad_option(opt->name, value, "one of g1, hertz, g1x") : 0;
     case SCHEME:
-        return parse_word(value, schemes, (int *)at) ? bad_option(opt->name, value, "one of sdirk2, central") : 0;
+        return parse_word(value, scheme_words, (int *)at) ? bad_option(opt->name, value, "one of sdirk2, central") : 0;
     case SCENE:
-        return parse_word(value, scenes, (int *)at) ? bad_option(opt->name, value, "one of drop, driven") : 0;
+        return parse_word(value, scene_words, (int *)at) ? bad_option(opt->name, value, "one of drop, driven") : 0;
     case TEXT:
         *(const char **)at = value;
         return 0;
@@ -161,6 +202,10 @@ static int parse(int argc, char **argv, options *o)
         const option *opt = NULL;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
+            return -1;
+        }
+        if (strcmp(argv[i], "--list-options") == 0) {
+            list_options();
             return -1;
         }
         snprintf(name, sizeof name, "%.*s", eq ? (int)(eq - argv[i]) : (int)strlen(argv[i]), argv[i]);
