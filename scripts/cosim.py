@@ -17,8 +17,11 @@ Used by scripts/cosim_study.py and tests/test_cosim.py; also a command:
 """
 
 import argparse
+import atexit
+import functools
 import json
 import pathlib
+import shutil
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
@@ -29,12 +32,22 @@ COUPLINGS = ("zoh", "mass-aware")
 ORDERS = ("jacobi", "gauss-seidel")
 
 
+@functools.lru_cache(maxsize=None)
+def unpacked(path):
+    """The FMU's model description and the folder it is extracted to: once
+    per file and process (a study makes hundreds of instances), removed when
+    the process exits. The instances share the folder's shared library."""
+    md = read_model_description(path)
+    folder = extract(path)
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    return md, folder
+
+
 class Unit:
     """One FMU instance, its variables by name."""
 
     def __init__(self, path, name, values):
-        md = read_model_description(str(path))
-        self.folder = extract(str(path))
+        md, self.folder = unpacked(str(pathlib.Path(path).resolve()))
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
         self.types = {v.name: v.type for v in md.modelVariables}
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.folder,

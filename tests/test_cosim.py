@@ -3,6 +3,8 @@ test, and the same scene in libcosim, an independent FMI 2.0 importer."""
 
 import os
 import pathlib
+import subprocess
+import sys
 
 import pytest
 
@@ -53,3 +55,29 @@ def test_libcosim_runs_the_scene_as_our_jacobi_master_does(coupling):
     theirs = cosimulate_libcosim(CONTACT, STRIKER, 2e-5, coupling)
     for key in ("F_peak", "eps", "energy_error"):
         assert theirs[key] == pytest.approx(ours[key], rel=1e-12, abs=1e-15), key
+
+
+# A child process with its own TMPDIR: fmpy's extract() makes its folders with
+# tempfile.mkdtemp() ("tmp" + 8 characters in the temp dir), so counting them
+# there sees only this driver's, not those of tests running alongside.
+COUNT_EXTRACTIONS = """
+import pathlib, sys, tempfile
+sys.path.insert(0, {scripts!r})
+from cosim import cosimulate, monolithic
+folders = lambda: len(list(pathlib.Path(tempfile.gettempdir()).glob("tmp*")))
+for H in (1e-4, 2e-4, 5e-4):
+    cosimulate({contact!r}, {striker!r}, H, "mass-aware", "gauss-seidel")
+    monolithic({contact!r}, H=H)
+    print(folders())
+"""
+
+
+def test_each_fmu_is_extracted_once_and_removed_at_exit(tmp_path):
+    """Issue 10, item 15: one folder per FMU file while the process runs
+    (not one per instance: hundreds per study), none left after it."""
+    code = COUNT_EXTRACTIONS.format(scripts=str(ROOT / "scripts"), contact=str(CONTACT), striker=str(STRIKER))
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=dict(os.environ, TMPDIR=str(tmp_path)), timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert [int(n) for n in run.stdout.split()] == [2, 2, 2]  # the contact FMU and the striker FMU
+    assert list(tmp_path.glob("tmp*")) == []
