@@ -1,12 +1,19 @@
 """scripts/sweep.py on a local Dask cluster with a small grid: every impact
-is the solver's own result, in case order; a Monte Carlo campaign is
-reproducible from its seed; bad grids are refused."""
+is the solver's own result, in case order; any solver option can be varied or
+set, by its name with dashes or underscores; a Monte Carlo campaign is
+reproducible from its seed, scatters log-normally with the stated mean and
+coefficient of variation, and reports statistics that numpy computes alike
+from the CSV; bad sweeps are refused."""
 
 import csv
 import json
+import math
 import os
+import pathlib
 import subprocess
+import sys
 
+import numpy as np
 import pytest
 
 import sweep
@@ -17,10 +24,43 @@ import sweep
 pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
                                 reason="Dask workers under a preloaded sanitizer runtime")
 
+SWEEP = pathlib.Path(sweep.__file__)
+# The paper's h20 constants, the solver's defaults (its --help).
+K, C = 3.299e8, 6080.0
+
 
 def read(path):
     with open(path) as f:
         return list(csv.DictReader(f))
+
+
+def solve(*options, solver=None):
+    """One direct run of the solver: its JSON object."""
+    done = subprocess.run([str(solver or sweep.SOLVER), "--json", "--quiet", *options], capture_output=True, text=True,
+                          check=True)
+    return json.loads(done.stdout)
+
+
+def number(text):
+    """The CSV cell as a float, or None when it is no number (True, g1)."""
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def assert_row_is_the_solver_result(row, direct, inputs):
+    """Every scalar number of the solver's JSON is in the row (as NAME_result
+    when NAME is an input column), to the last bit but for printing: the CSV
+    holds Python's shortest round-trip repr, and the same binary with the
+    same inputs is deterministic, so 1e-12 is only a guard against a value
+    passing through a shorter format."""
+    for key, value in direct.items():
+        if key == "cpu_seconds" or not isinstance(value, (int, float)) or isinstance(value, bool):
+            continue
+        column = f"{key}_result" if key in inputs else key
+        assert float(row[column]) == pytest.approx(value, rel=1e-12), key
+    assert row["separated"] == str(direct["separated"])
 
 
 @pytest.fixture(scope="module")
@@ -36,13 +76,56 @@ def test_grid_results_are_the_solver_results_in_order(grid):
     assert [(float(r["height"]), float(r["c"])) for r in rows] == [
         (h, c) for h in (0.01, 0.02, 0.03) for c in (3000.0, 6080.0)]
     for r in rows:
-        direct = json.loads(subprocess.run([str(sweep.SOLVER), "--json", "--law", "hertz", "--height", r["height"],
-                                            "--c", r["c"]], capture_output=True, text=True, check=True).stdout)
-        for key in sweep.RESULTS:
-            assert float(r[key]) == pytest.approx(direct[key], rel=1e-12), key
+        # No --law: the sweep's default law is the solver's own (g1).
+        assert_row_is_the_solver_result(r, solve("--height", r["height"], "--c", r["c"]), ("height", "c"))
     summary = json.loads((grid / "sweep.json").read_text())
     assert summary["impacts"] == 6 and summary["failed"] == 0 and summary["impacts_per_second"] > 0
     assert (grid / "sweep.png").stat().st_size > 10000
+
+
+def test_help_states_the_default_law_and_the_scatter():
+    done = subprocess.run([sys.executable, str(SWEEP), "--help"], capture_output=True, text=True, check=True)
+    text = " ".join(done.stdout.split())
+    assert "default law: g1" in text
+    assert "coefficient of variation" in text and "log-normal" in text
+
+
+def test_any_solver_option_by_either_name(tmp_path):
+    """Issue 10, item 12: t-end, law and impacts were refused; E_s, t_end are
+    the FMU-style spellings of --E-s, --t-end; reference is a flag."""
+    assert sweep.main(["--vary", "law=hertz,g1x", "--vary", "impacts=1,3", "--vary", "t_end=0.05,0.3",
+                       "--vary", "reference=false,true", "--set", "g=9.81", "--set", "E_s=2e9", "--set", "k=0",
+                       "--workers", "2", "--batch", "3", "--out", str(tmp_path)]) == 0
+    rows = read(tmp_path / "sweep.csv")
+    assert len(rows) == 16 and list(rows[0])[:4] == ["law", "impacts", "t-end", "reference"]
+    for r in rows:
+        direct = solve("--law", r["law"], "--impacts", r["impacts"], "--t-end", r["t-end"], "--g", "9.81",
+                       "--E-s", "2e9", "--k", "0", *(["--reference"] if r["reference"] == "True" else []))
+        assert_row_is_the_solver_result(r, direct, ("law", "impacts", "t-end", "reference"))
+
+
+def test_results_skip_what_is_no_scalar_number(tmp_path):
+    """A solver whose JSON gains a list of objects and a string (per_impact,
+    stopped): the CSV keeps the scalar numbers and drops those two."""
+    wrapper = tmp_path / "solver"
+    wrapper.write_text(f"""#!{sys.executable}
+import json, subprocess, sys
+done = subprocess.run([{str(sweep.SOLVER)!r}] + sys.argv[1:], capture_output=True, text=True)
+if done.returncode == 0 and "--json" in sys.argv:
+    r = json.loads(done.stdout)
+    done.stdout = json.dumps(dict(r, per_impact=[dict(F_peak=r["F_peak"], eps=r["eps"])], stopped="impacts"))
+sys.stdout.write(done.stdout)
+sys.stderr.write(done.stderr)
+sys.exit(done.returncode)
+""")
+    wrapper.chmod(0o755)
+    assert "per_impact" in solve(solver=wrapper)
+    assert sweep.main(["--vary", "m=0.5,1", "--solver", str(wrapper), "--workers", "1",
+                       "--out", str(tmp_path / "out")]) == 0
+    rows = read(tmp_path / "out" / "sweep.csv")
+    assert "per_impact" not in rows[0] and "stopped" not in rows[0]
+    for r in rows:
+        assert_row_is_the_solver_result(r, solve("--m", r["m"]), ("m",))
 
 
 def test_monte_carlo_is_reproducible(tmp_path):
@@ -54,9 +137,80 @@ def test_monte_carlo_is_reproducible(tmp_path):
     assert runs[0] == runs[1] and len({r["k"] for r in runs[0]}) == 8
 
 
-@pytest.mark.parametrize("args", [["--vary", "height=0.1:0.01:0.01"], ["--vary", "bogus=1"], ["--monte-carlo", "5"],
-                                  ["--workers", "0"]])
-def test_bad_sweeps_are_refused(args, tmp_path):
+N = 200  # impacts of the Monte Carlo fixture
+CV = dict(k=0.3, c=5.0)  # c = 5 is the report's: 500 %, which gave negative c
+
+
+@pytest.fixture(scope="module")
+def monte_carlo(tmp_path_factory):
+    """The command line as a user runs it, for its printed statistics too;
+    k's scatter as a percentage, c's as a fraction. The softest dashpots
+    drawn never let the striker go: t_end = 20 ms (the h20 contact lasts
+    1.3 ms) instead of 1 s keeps them short."""
+    out = tmp_path_factory.mktemp("monte_carlo")
+    done = subprocess.run([sys.executable, str(SWEEP), "--monte-carlo", str(N), "--scatter", "k=30%", "--scatter",
+                           "c=5", "--set", "t_end=0.02", "--seed", "11", "--workers", "2", "--out", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return out, done.stdout
+
+
+@pytest.mark.parametrize("name, nominal", [("k", K), ("c", C)])
+def test_scatter_is_log_normal_with_the_stated_mean_and_cv(monte_carlo, name, nominal):
+    """Issue 10, item 11. A log-normal variable with mean M and coefficient
+    of variation s has ln X ~ Normal(ln M - S^2/2, S^2), S^2 = ln(1 + s^2).
+    The sample mean of ln X has standard error S/sqrt(N) and the sample
+    standard deviation about S/sqrt(2(N-1)); 4 standard errors pass a
+    correct draw with probability 1 - 6e-5 whatever the seed, and still
+    tell a normal scatter (half of c negative: no logarithm at all) apart."""
+    rows = read(monte_carlo[0] / "sweep.csv")
+    assert len(rows) == N and not any(r.get("error") for r in rows)
+    x = np.array([float(r[name]) for r in rows])
+    assert (x > 0).all()
+    s2 = math.log1p(CV[name] ** 2)
+    assert np.log(x).mean() == pytest.approx(math.log(nominal) - s2 / 2, abs=4 * math.sqrt(s2 / N))
+    assert np.log(x).std(ddof=1) == pytest.approx(math.sqrt(s2), abs=4 * math.sqrt(s2 / (2 * (N - 1))))
+
+
+def test_statistics_are_numpys_on_the_csv(monte_carlo):
+    """sweep.json's statistics of every numeric column are numpy's on the
+    written CSV (sample std, linear-interpolation percentiles). The same
+    doubles in both; 1e-12 allows another summation order (N * 2^-53 = 2e-14).
+    The printed table has 6 significant digits: rounding moves a value by
+    at most 5e-6 of itself."""
+    out, printed = monte_carlo
+    rows = read(out / "sweep.csv")
+    columns = [key for key in rows[0] if all(number(r[key]) is not None for r in rows)]
+    statistics = json.loads((out / "sweep.json").read_text())["statistics"]
+    assert set(statistics) == set(columns)
+    assert {"F_peak", "eps", "t_contact", "x_perm", "E_diss", "k", "c"} <= set(columns)
+    lines = {line.split()[0]: line.split()[1:] for line in printed.splitlines() if line.split()}
+    for key in columns:
+        x = np.array([float(r[key]) for r in rows])
+        truth = dict(mean=x.mean(), std=x.std(ddof=1), p5=np.percentile(x, 5), p50=np.percentile(x, 50),
+                     p95=np.percentile(x, 95))
+        assert statistics[key] == pytest.approx(truth, rel=1e-12, abs=1e-300), key
+        assert [float(v) for v in lines[key]] == pytest.approx(list(truth.values()), rel=5e-6, abs=1e-300), key
+    assert (out / "sweep.png").stat().st_size > 20000
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--vary", "height=0.1:0.01:0.01"], "stop >= start"),
+    (["--vary", "bogus=1"], "unknown option 'bogus'"),
+    (["--monte-carlo", "5"], "needs at least one --scatter"),
+    (["--workers", "0"], "must be >= 1"),
+    (["--monte-carlo", "5", "--scatter", "c=-0.1"], "negative"),
+    (["--monte-carlo", "5", "--scatter", "g=0.1"], "positive nominal"),
+    (["--monte-carlo", "5", "--scatter", "g1_nodes=0.1"], "only real"),
+    (["--monte-carlo", "5", "--scatter", "height=0.1"], "--set height="),
+    (["--set", "law=foo"], "one of g1, hertz, g1x"),
+    (["--vary", "impacts=1.5"], "impacts"),
+    (["--set", "csv=x.csv"], "writes its own CSV"),
+    (["--set", "output_interval=1e-6"], "writes its own CSV"),
+    (["--set", "json=true"], "always"),
+])
+def test_bad_sweeps_are_refused(args, message, tmp_path, capsys):
     with pytest.raises(SystemExit) as e:
         sweep.main(args + ["--out", str(tmp_path)])
     assert e.value.code == 2
+    assert message in capsys.readouterr().err
