@@ -43,15 +43,21 @@ double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s
     return 4.0 / 3.0 * E_star * sqrt(R);
 }
 
-/* The value as the user typed it: the shortest of 15 or 17 digits that
- * reads back as the same double. */
+/* The value as a user would type it: printf's %g (1.2e+09, 6080), with
+ * more digits only where the double needs them to read back the same. */
+static const char *shown(double value, char text[32])
+{
+    int digits = 6;
+    do
+        snprintf(text, 32, "%.*g", digits, value);
+    while (strtod(text, NULL) != value && value == value && ++digits <= 17);
+    return text;
+}
+
 static int reject(char *msg, size_t len, const char *name, double value, const char *rule)
 {
-    char shown[32];
-    snprintf(shown, sizeof shown, "%.15g", value);
-    if (strtod(shown, NULL) != value && value == value)
-        snprintf(shown, sizeof shown, "%.17g", value);
-    snprintf(msg, len, "%s = %s is invalid: %s", name, shown, rule);
+    char text[32];
+    snprintf(msg, len, "%s = %s is invalid: %s", name, shown(value, text), rule);
     return -1;
 }
 
@@ -101,6 +107,40 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
     if (p->scheme != CONTACT_SCHEME_SDIRK2 && p->scheme != CONTACT_SCHEME_CENTRAL)
         return reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
     return 0;
+}
+
+/* The parameters that only serve to derive k. */
+static const struct {
+    const char *name;
+    size_t offset;
+} materials[] = {{"R", offsetof(contact_params, R)},
+                 {"E_i", offsetof(contact_params, E_i)},
+                 {"nu_i", offsetof(contact_params, nu_i)},
+                 {"E_s", offsetof(contact_params, E_s)},
+                 {"nu_s", offsetof(contact_params, nu_s)}};
+
+#define MATERIAL(p, i) (*(const double *)((const char *)(p) + materials[i].offset))
+
+int contact_unused_material(const contact_params *p, char *msg, size_t len)
+{
+    contact_params d;
+    char text[32];
+    size_t i, used = 0, unused = 0;
+    contact_default_params(&d);
+    if (p->k == 0.0)
+        return 0;
+    for (i = 0; i < sizeof materials / sizeof materials[0]; i++)
+        if (MATERIAL(p, i) != MATERIAL(&d, i) && used < len) {
+            used += (size_t)snprintf(msg + used, len - used, "%s%s = %s", unused++ ? ", " : "", materials[i].name,
+                                     shown(MATERIAL(p, i), text));
+        }
+    if (!unused)
+        return 0;
+    if (used < len)
+        snprintf(msg + used, len - used,
+                 " %s no effect: k = %s is given and wins (set k = 0 to derive k from R, E_i, nu_i, E_s, nu_s)",
+                 unused > 1 ? "have" : "has", shown(p->k, text));
+    return 1;
 }
 
 int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
@@ -360,6 +400,7 @@ static double peak_force_within(const contact_model *cm, const contact_state *s,
 static void begin_contact(contact_state *s, double t, double v)
 {
     s->n = 0;
+    s->F_peak_contact = 0.0;
     s->v_onset = v;
     s->t_onset = t;
     s->in_contact = 1;
@@ -379,13 +420,17 @@ static void accept_contact_step(contact_state *s, const contact_state *trial, do
 {
     *s = *trial;
     s->n++;
+    if (peak > s->F_peak_contact)
+        s->F_peak_contact = peak;
     if (peak > s->F_peak)
         s->F_peak = peak;
 }
 
 /* One SDIRK step of length h, split at contact onset and separation.
- * Returns 0, or -1 when the events do not end (a diverging state). */
-static int sdirk_internal_step(contact_model *cm, double h, double *impulse)
+ * Returns 0, 1 when it stopped early at an event of the mask stop_at (the
+ * state's time tells where), or -1 when the events do not end (a diverging
+ * state). */
+static int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s, trial;
     int events;
@@ -397,6 +442,8 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse)
             fly(cm, tau < 0.0 ? h : tau, tau >= 0.0);
             if (tau < 0.0)
                 return 0;
+            if (stop_at & CONTACT_ONSET)
+                return 1;
             h -= tau;
             continue;
         }
@@ -414,6 +461,8 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse)
             return 0;
         s->x1 = 0.0;
         end_contact(s, s->t, s->v);
+        if (stop_at & CONTACT_SEPARATION)
+            return 1;
         h -= tau;
     }
     return -1;
@@ -449,36 +498,48 @@ static void central_internal_step(contact_model *cm, double h, double *impulse)
     }
     if (cm->inv_m > 0.0) /* second-order velocity at the step's end */
         s->v = (x_next - x) / h + 0.5 * h * (cm->accel - cm->inv_m * s->F);
+    if (s->F > s->F_peak_contact)
+        s->F_peak_contact = s->F;
     if (s->F > s->F_peak)
         s->F_peak = s->F;
     if (s->in_contact && !(x1_next > 0.0))
         end_contact(s, t + h * x1 / (x1 - x1_next), s->v);
 }
 
-static int internal_step(contact_model *cm, double h, double *impulse)
+/* One internal step: 0, 1 after an event of the mask stop_at (the central
+ * scheme stops at the end of the step in which it happened), or -1. */
+static int internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
+    int was_in_contact = cm->s.in_contact;
     cm->s.steps++;
     if (cm->p.scheme == CONTACT_SCHEME_CENTRAL) {
         central_internal_step(cm, h, impulse);
-        return 0;
+        return cm->s.in_contact != was_in_contact
+               && (stop_at & (cm->s.in_contact ? CONTACT_ONSET : CONTACT_SEPARATION));
     }
-    return sdirk_internal_step(cm, h, impulse);
+    return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
 int contact_state_is_finite(const contact_state *s)
 {
     return isfinite(s->t) && isfinite(s->x1) && isfinite(s->x2) && isfinite(s->v) && isfinite(s->F)
-           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->eps) && isfinite(s->v_onset)
+           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->F_peak_contact) && isfinite(s->eps) && isfinite(s->v_onset)
            && isfinite(s->t_onset) && isfinite(s->t_contact) && isfinite(s->x_prev) && isfinite(s->h_prev);
 }
 
 double contact_advance(contact_model *cm, double H)
 {
+    return contact_advance_until(cm, H, 0u);
+}
+
+double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
+{
     const contact_state start = cm->s;
     double remaining = H, impulse = 0.0;
+    int stopped = 0;
     if (!(H > 0.0))
         return 0.0;
-    while (remaining > 0.0) {
+    while (remaining > 0.0 && !stopped) {
         double n, h, i;
         if (!cm->s.in_contact && cm->p.scheme == CONTACT_SCHEME_SDIRK2) {
             /* Free flight is exact at any length: one step to the onset, or
@@ -487,6 +548,7 @@ double contact_advance(contact_model *cm, double H)
             cm->s.steps++;
             fly(cm, tau < 0.0 ? remaining : tau, tau >= 0.0);
             remaining = tau < 0.0 ? 0.0 : remaining - tau;
+            stopped = tau >= 0.0 && (stop_at & CONTACT_ONSET);
             continue;
         }
         /* In contact: equal steps of at most dt_max over the rest, rounding
@@ -494,11 +556,14 @@ double contact_advance(contact_model *cm, double H)
          * not n + 1 with a sliver), until the contact ends. */
         n = fmax(1.0, ceil(remaining / cm->p.dt_max * (1.0 - 1e-12)));
         h = remaining / n;
-        for (i = 0; i < n && (cm->s.in_contact || cm->p.scheme == CONTACT_SCHEME_CENTRAL); i++)
-            if (internal_step(cm, h, &impulse) != 0) {
+        for (i = 0; i < n && !stopped && (cm->s.in_contact || cm->p.scheme == CONTACT_SCHEME_CENTRAL); i++) {
+            int status = internal_step(cm, h, &impulse, stop_at);
+            if (status < 0) {
                 cm->s = start;
                 return NAN;
             }
+            stopped = status;
+        }
         remaining = i < n ? remaining - i * h : 0.0;
     }
     /* A non-finite value stays non-finite through the steps that follow
@@ -507,8 +572,20 @@ double contact_advance(contact_model *cm, double H)
         cm->s = start;
         return NAN;
     }
-    cm->s.t = start.t + H;
+    if (!stopped)
+        cm->s.t = start.t + H;
     return impulse;
+}
+
+int contact_never_returns(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    const double a = cm->accel;
+    if (s->in_contact || a > 0.0)
+        return 0;
+    if (s->v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
+        return a < 0.0 && !(s->x1 + 0.5 * s->v * s->v / -a > 0.0);
+    return 1;
 }
 
 double contact_elastic_indentation(const contact_model *cm)

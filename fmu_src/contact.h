@@ -5,6 +5,7 @@
 #define FRACCONTACT_CONTACT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 enum contact_law {
     CONTACT_LAW_G1 = 1,              /* G1 history sum of D^(-1/2) x1, times Gamma(5/2) k */
@@ -15,6 +16,12 @@ enum contact_law {
 enum contact_scheme {
     CONTACT_SCHEME_SDIRK2 = 1,  /* L-stable implicit, second order, events located (default) */
     CONTACT_SCHEME_CENTRAL = 2  /* the paper's explicit central differences (MODEL.md §5) */
+};
+
+/* Events at which contact_advance_until can stop, as bits. */
+enum contact_event {
+    CONTACT_ONSET = 1,      /* the striker meets the specimen */
+    CONTACT_SEPARATION = 2  /* the force returns to zero: an impact has ended */
 };
 
 enum contact_scene {
@@ -45,16 +52,17 @@ typedef struct {
     double v;         /* striker velocity towards the specimen [m/s] */
     double F;         /* contact force at the end of the last internal step [N] */
     double F_peak;    /* largest contact force so far [N] */
+    double F_peak_contact; /* largest force of the current (or last) contact [N] */
     double E_diss;    /* energy dissipated by the dashpot so far [J] */
     double eps;       /* restitution coefficient of the last finished impact */
     double v_onset;   /* striker velocity at the onset of the current contact */
     double t_onset;   /* time of the onset of the current (or last) contact [s] */
     double t_contact; /* duration of the last finished impact [s] */
-    long n;           /* internal steps since the onset of the current contact */
-    long steps;       /* internal steps taken */
+    int64_t n;        /* internal steps since the onset of the current contact */
+    int64_t steps;    /* internal steps taken */
     double x_prev;    /* central differences: total indentation one step back, */
     double h_prev;    /* and that step (0: not yet known) */
-    long impacts;     /* finished impacts */
+    int64_t impacts;  /* finished impacts */
     int in_contact;
 } contact_state;
 
@@ -78,6 +86,11 @@ double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s
  * first offending parameter and its value. */
 int contact_check_params(const contact_params *p, char *msg, size_t len);
 
+/* A warning when k != 0 is given while a material parameter (R, E_i, nu_i,
+ * E_s, nu_s) differs from its default: k wins, and that value has no effect.
+ * Returns 1 and the message naming the first such parameter, or 0. */
+int contact_unused_material(const contact_params *p, char *msg, size_t len);
+
 /* The same for the striker inputs: velocity v [m/s] and mass m [kg]. */
 int contact_check_striker(int scene, double v, double m, char *msg, size_t len);
 
@@ -100,11 +113,20 @@ void contact_drive(contact_model *cm, double v, double m, double slope);
 void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate);
 
 /* Advances the model by H >= 0 in equal internal steps of at most dt_max that
- * land exactly on t + H, locating contact onset and separation within a step.
- * Returns the impulse of the contact force over the interval [N s]; on a
- * numerical failure (a non-finite state) returns NaN and leaves the state at
- * the start of the failing internal step. */
+ * land exactly on t + H, locating contact onset and separation within a step;
+ * free flight is one exact step. Returns the impulse of the contact force
+ * over the interval [N s]; on a numerical failure (a non-finite state)
+ * returns NaN and leaves the state as it was at the start of the advance. */
 double contact_advance(contact_model *cm, double H);
+
+/* The same, but it stops right after the first event of the mask stop_at
+ * (enum contact_event bits) inside the interval: cm->s.t then tells where. */
+double contact_advance_until(contact_model *cm, double H, unsigned stop_at);
+
+/* Whether the striker is out of contact and its free flight never reaches
+ * the specimen again (it moves away, or rests, and nothing accelerates it
+ * back): nothing changes from then on. */
+int contact_never_returns(const contact_model *cm);
 
 /* Whether every value of the state is finite. */
 int contact_state_is_finite(const contact_state *s);

@@ -13,21 +13,23 @@
 #include "guid.h"
 #include "serial.h"
 
-/* The states of FMI 2.0 §4.2.4 that a synchronous slave can be in, as bits,
- * so that each function names the set of states it may be called in. */
+/* The states of FMI 2.0 §4.2.4 that this slave can be in, as bits, so that
+ * each function names the set of states it may be called in. There is no
+ * stepFailed, error or fatal state: a refused call changes nothing, and a
+ * step that fails (fmi2Error) keeps the model at the start of the step, in
+ * stepComplete, so the master may retry with a shorter step, restore a
+ * state, reset, or terminate. */
 enum {
     INSTANTIATED = 1 << 0,
     INITIALIZATION_MODE = 1 << 1,
     STEP_COMPLETE = 1 << 2,
-    STEP_FAILED = 1 << 3,
-    TERMINATED = 1 << 4,
-    ERROR_STATE = 1 << 5
+    TERMINATED = 1 << 4
 };
 
-#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
-#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
+#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
+#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
 #define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE)
-#define STEPPING (STEP_COMPLETE | STEP_FAILED | TERMINATED)
+#define STEPPING (STEP_COMPLETE | TERMINATED)
 
 static const char *const log_categories[] = {"logEvents", "logCalls", "logStatusWarning", "logStatusError"};
 #define N_CATEGORIES (sizeof log_categories / sizeof log_categories[0])
@@ -232,21 +234,24 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 }
 
 /* A rejected start leaves the instance in initialization mode, so that the
- * master can correct the value and try again. */
+ * master can correct the value and try again; a start with a warning (a
+ * value that has no effect) goes ahead. */
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
     instance *in = c;
+    fm_status status;
     REQUIRE(INITIALIZATION_MODE, "fmi2ExitInitializationMode");
-    if (fm_start(in->fm, in->start_time) != FM_OK)
+    status = fm_start(in->fm, in->start_time);
+    if (status == FM_ERROR)
         return fmi2Error;
     in->state = STEP_COMPLETE;
-    return fmi2OK;
+    return (fmi2Status)status;
 }
 
 fmi2Status fmi2Terminate(fmi2Component c)
 {
     instance *in = c;
-    REQUIRE(STEP_COMPLETE | STEP_FAILED, "fmi2Terminate");
+    REQUIRE(STEP_COMPLETE, "fmi2Terminate");
     in->state = TERMINATED;
     return fmi2OK;
 }
@@ -413,7 +418,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
  *   then the payload: the instance's mode and start time, then the model's
  *   state (fm_state_write). All integers little-endian. */
 #define STATE_MAGIC "FCST"
-#define STATE_FORMAT 1u
+#define STATE_FORMAT 2u
 #define STATE_HEADER 20u
 #define STATE_INSTANCE 12u /* mode (u32), start time (f64) */
 
@@ -469,8 +474,7 @@ static const char *state_problem(const unsigned char *b, size_t size)
 
 static int valid_mode(uint32_t mode)
 {
-    return mode == INSTANTIATED || mode == INITIALIZATION_MODE || mode == STEP_COMPLETE || mode == STEP_FAILED
-           || mode == TERMINATED;
+    return mode == INSTANTIATED || mode == INITIALIZATION_MODE || mode == STEP_COMPLETE || mode == TERMINATED;
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
@@ -618,7 +622,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 {
     instance *in = c;
     size_t i;
-    REQUIRE(STEPPING | ERROR_STATE, "fmi2GetRealOutputDerivatives");
+    REQUIRE(STEPPING, "fmi2GetRealOutputDerivatives");
     if (null_arrays(in, nvr, vr, value, "fmi2GetRealOutputDerivatives")
         || null_arrays(in, nvr, order, order, "fmi2GetRealOutputDerivatives"))
         return fmi2Error;

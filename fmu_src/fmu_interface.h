@@ -34,7 +34,8 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value);
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value);
 fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value);
 
-/* End of initialization: checks what the model needs, starts it at t0. */
+/* End of initialization: checks what the model needs, starts it at t0.
+ * FM_WARNING: started, with a reported warning (a value without effect). */
 fm_status fm_start(fmu_model *fm, double t0);
 
 /* One communication step [t, t + H], and the model's time. */

@@ -2,6 +2,7 @@
 
 #include "fmu_vars.h"
 
+#include <inttypes.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -252,7 +253,7 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
 
 fm_status fm_start(fmu_model *fm, double t0)
 {
-    char why[256];
+    char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
         || contact_check_striker(fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
@@ -260,6 +261,8 @@ fm_status fm_start(fmu_model *fm, double t0)
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
     fm->started = 1;
+    if (contact_unused_material(&fm->params, why, sizeof why))
+        return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     return FM_OK;
 }
 
@@ -267,7 +270,7 @@ static void report_events(fmu_model *fm, const contact_state *before)
 {
     const contact_state *s = &fm->model.s;
     if (s->impacts != before->impacts)
-        report(fm, FM_OK, "logEvents", "impact %ld ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N",
+        report(fm, FM_OK, "logEvents", "impact %" PRId64 " ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N",
                s->impacts, s->t, s->eps, s->x2, s->F_peak);
     if (s->in_contact && (!before->in_contact || s->impacts != before->impacts))
         report(fm, FM_OK, "logEvents", "contact began in (%.9g, %.9g] s at %.6g m/s",
@@ -332,7 +335,7 @@ static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
     I(params.scheme), F(v), F(m), F(v_slope), F(F_avg), I(started), F(model.inv_m), F(model.accel),
-    F(model.s.t), F(model.s.x1), F(model.s.x2), F(model.s.v), F(model.s.F), F(model.s.F_peak),
+    F(model.s.t), F(model.s.x1), F(model.s.x2), F(model.s.v), F(model.s.F), F(model.s.F_peak), F(model.s.F_peak_contact),
     F(model.s.E_diss), F(model.s.eps), F(model.s.v_onset), F(model.s.t_onset), F(model.s.t_contact),
     F(model.s.x_prev), F(model.s.h_prev), L(model.s.n), L(model.s.steps), L(model.s.impacts),
     I(model.s.in_contact)};

@@ -72,7 +72,7 @@ void fmu_fields_write(const void *base, const state_field *fields, size_t n, uns
         else if (fields[i].kind == FIELD_I32)
             serial_put_u32(bytes, (uint32_t) * (const int *)at);
         else
-            serial_put_u64(bytes, (uint64_t) * (const long *)at);
+            serial_put_u64(bytes, (uint64_t) * (const int64_t *)at);
         bytes += field_size(fields[i].kind);
     }
 }
@@ -87,7 +87,7 @@ void fmu_fields_read(void *base, const state_field *fields, size_t n, const unsi
         else if (fields[i].kind == FIELD_I32)
             *(int *)at = (int)(int32_t)serial_get_u32(bytes);
         else
-            *(long *)at = (long)(int64_t)serial_get_u64(bytes);
+            *(int64_t *)at = (int64_t)serial_get_u64(bytes);
         bytes += field_size(fields[i].kind);
     }
 }

@@ -44,7 +44,7 @@ const fmu_variable *fmu_settable(const fmu_variables *vars, unsigned vr, var_typ
                                  const fmu_reporter *r);
 
 /* A model's FMU state as a table of fields (offsets into its struct), in the
- * layout of serial.h: doubles bit for bit, ints and longs little-endian. */
+ * layout of serial.h: doubles bit for bit, 32- and 64-bit integers (int, int64_t) little-endian. */
 typedef enum { FIELD_F64, FIELD_I32, FIELD_I64 } field_kind;
 
 typedef struct {

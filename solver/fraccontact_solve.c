@@ -4,6 +4,7 @@
  * the impact's figures; --csv writes the time series, --json one object. */
 #define _POSIX_C_SOURCE 200809L
 
+#include <inttypes.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -13,9 +14,11 @@
 
 #include "contact.h"
 #include "reference.h"
+#include "run.h"
 #include "timing.h"
 
 #define PROGRAM "fraccontact-solve"
+#define N_OPTIONS_MAX 32
 #define G_EARTH 9.81
 
 typedef struct {
@@ -24,50 +27,88 @@ typedef struct {
     int impacts, repeat;
     const char *csv;
     int json, reference, quiet;
+    const char *typed[N_OPTIONS_MAX]; /* each option's value as typed (NULL: not given) */
 } options;
 
 /* ------------------------------------------------------------ options */
 
 typedef enum { REAL, INTEGER, LAW, SCHEME, SCENE, TEXT, FLAG } option_kind;
 
+/* A rule an option's value must follow: NULL when it does, else the rule. */
+typedef const char *(*option_rule)(const void *value);
+
 typedef struct {
     const char *name;
     option_kind kind;
     size_t offset;
     const char *help;
+    const char *variable; /* the model's name for it, as in its messages */
+    option_rule rule;     /* for the solver's own options (the model checks its own) */
 } option;
 
 #define AT(field) offsetof(options, field)
 
+static const char *finite_nonnegative(const void *value)
+{
+    double x = *(const double *)value;
+    return isfinite(x) && x >= 0.0 ? NULL : "must be finite and >= 0";
+}
+
+static const char *finite_positive(const void *value)
+{
+    double x = *(const double *)value;
+    return isfinite(x) && x > 0.0 ? NULL : "must be positive and finite";
+}
+
+static const char *between_0_and_1(const void *value)
+{
+    double x = *(const double *)value;
+    return x > 0.0 && x < 1.0 ? NULL : "must lie in (0, 1)";
+}
+
+static const char *at_least_one(const void *value)
+{
+    return *(const int *)value >= 1 ? NULL : "must be >= 1";
+}
+
+static const char *repeat_count(const void *value)
+{
+    int n = *(const int *)value;
+    return n >= 1 && n <= 100000 ? NULL : "must lie in 1..100000";
+}
+
 static const option table[] = {
-    {"--height", REAL, AT(height), "drop height h [m]: v0 = sqrt(2 * 9.81 * h) (overrides --v0)"},
-    {"--v0", REAL, AT(v0), "impact velocity towards the specimen [m/s] (default 0.626418, the paper's 20 mm); driven scene: the constant indentation rate"},
-    {"--m", REAL, AT(m), "striker mass [kg] (default 0.7437); driven scene: 0 = no inertia"},
-    {"--k", REAL, AT(p.k), "Hertz constant [N/m^1.5] (default 3.299e8); 0 derives it from --R, --E-i, --nu-i, --E-s, --nu-s"},
-    {"--c", REAL, AT(p.c), "dashpot constant [N s/m] (default 6080)"},
-    {"--R", REAL, AT(p.R), "striker tip radius [m] (default 6.35e-3)"},
-    {"--E-i", REAL, AT(p.E_i), "indenter Young's modulus [Pa] (default 210e9)"},
-    {"--nu-i", REAL, AT(p.nu_i), "indenter Poisson ratio (default 0.3)"},
-    {"--E-s", REAL, AT(p.E_s), "specimen Young's modulus [Pa] (default 2.64e9)"},
-    {"--nu-s", REAL, AT(p.nu_s), "specimen Poisson ratio (default 0.4)"},
-    {"--law", LAW, AT(p.law), "spring law: g1 (G1 history sum, default), hertz (closed form), g1x (G1 with Richardson extrapolation)"},
-    {"--g1-nodes", INTEGER, AT(p.g1_nodes), "G1 intervals N (default 0: internal steps since contact onset)"},
-    {"--dt", REAL, AT(p.dt_max), "internal time step [s] (default 1e-7)"},
-    {"--scheme", SCHEME, AT(p.scheme), "time scheme: sdirk2 (implicit, L-stable, second order; default) or central (the paper's explicit central differences)"},
-    {"--scene", SCENE, AT(p.scene), "drop (default: a free striker) or driven (constant indentation rate --v0)"},
-    {"--g", REAL, AT(p.g), "acceleration of the striker towards the specimen [m/s^2] (default 0; 9.81 for gravity)"},
-    {"--gap0", REAL, AT(p.gap0), "gap between striker and specimen at t = 0 [m] (default 0)"},
-    {"--t-end", REAL, AT(t_end), "stop at this time if the impacts have not ended [s] (default 1)"},
-    {"--impacts", INTEGER, AT(impacts), "stop after this many finished impacts (default 1)"},
-    {"--output-interval", REAL, AT(output_interval), "time between rows of --csv [s] (default: every internal step; the reference: 1/64 of the contact time scale)"},
-    {"--csv", TEXT, AT(csv), "write the time series to FILE: t, F, x, x1, x2, v, E_diss (SI units)"},
-    {"--json", FLAG, AT(json), "print one JSON object instead of the table"},
-    {"--reference", FLAG, AT(reference), "solve with GSL's high-accuracy integrator instead of the model's scheme"},
-    {"--rtol", REAL, AT(rtol), "relative tolerance of --reference (default 1e-12)"},
-    {"--repeat", INTEGER, AT(repeat), "solve this many times and report the median cpu_seconds (default 1; for timing)"},
-    {"--quiet", FLAG, AT(quiet), "no progress line on a terminal"},
+    {"--height", REAL, AT(height), "drop height h [m]: v0 = sqrt(2 * 9.81 * h) (overrides --v0)", NULL,
+     finite_nonnegative},
+    {"--v0", REAL, AT(v0), "impact velocity towards the specimen [m/s] (default 0.626418, the paper's 20 mm); driven scene: the constant indentation rate", "v", NULL},
+    {"--m", REAL, AT(m), "striker mass [kg] (default 0.7437); driven scene: 0 = no inertia", "m", NULL},
+    {"--k", REAL, AT(p.k), "Hertz constant [N/m^1.5] (default 3.299e8); 0 derives it from --R, --E-i, --nu-i, --E-s, --nu-s; a k other than 0 wins over them (a warning says so when one of them is set)", "k", NULL},
+    {"--c", REAL, AT(p.c), "dashpot constant [N s/m] (default 6080)", "c", NULL},
+    {"--R", REAL, AT(p.R), "striker tip radius [m] (default 6.35e-3; used only with --k 0)", "R", NULL},
+    {"--E-i", REAL, AT(p.E_i), "indenter Young's modulus [Pa] (default 210e9; used only with --k 0)", "E_i", NULL},
+    {"--nu-i", REAL, AT(p.nu_i), "indenter Poisson ratio (default 0.3; used only with --k 0)", "nu_i", NULL},
+    {"--E-s", REAL, AT(p.E_s), "specimen Young's modulus [Pa] (default 2.64e9; used only with --k 0)", "E_s", NULL},
+    {"--nu-s", REAL, AT(p.nu_s), "specimen Poisson ratio (default 0.4; used only with --k 0)", "nu_s", NULL},
+    {"--law", LAW, AT(p.law), "spring law: g1 (G1 history sum, default), hertz (closed form), g1x (G1 with Richardson extrapolation)", "law", NULL},
+    {"--g1-nodes", INTEGER, AT(p.g1_nodes), "G1 intervals N (default 0: internal steps since contact onset)", "g1_nodes", NULL},
+    {"--dt", REAL, AT(p.dt_max), "internal time step [s] (default 1e-7)", "dt_max", NULL},
+    {"--scheme", SCHEME, AT(p.scheme), "time scheme: sdirk2 (implicit, L-stable, second order; default) or central (the paper's explicit central differences)", "scheme", NULL},
+    {"--scene", SCENE, AT(p.scene), "drop (default: a free striker) or driven (constant indentation rate --v0)", "scene", NULL},
+    {"--g", REAL, AT(p.g), "acceleration of the striker towards the specimen [m/s^2] (default 0; 9.81 for gravity)", "g", NULL},
+    {"--gap0", REAL, AT(p.gap0), "gap between striker and specimen at t = 0 [m] (default 0)", "gap0", NULL},
+    {"--t-end", REAL, AT(t_end), "stop at this time if the solve has not stopped before [s] (default 1)", NULL,
+     finite_positive},
+    {"--impacts", INTEGER, AT(impacts), "stop right after this many impacts have ended (default 1)", NULL, at_least_one},
+    {"--output-interval", REAL, AT(output_interval), "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row after every internal step (large). Default: 1/256 of the elastic Hertz contact time at the impact speed (about 250 rows per contact; 4.8 us at the h20 defaults), or --t-end / 1000 in the driven scene without mass", NULL, finite_nonnegative},
+    {"--csv", TEXT, AT(csv), "write the time series to FILE: t, F, x, x1, x2, v, E_diss (SI units)", NULL, NULL},
+    {"--json", FLAG, AT(json), "print one JSON object instead of the table", NULL, NULL},
+    {"--reference", FLAG, AT(reference), "solve with GSL's high-accuracy integrator instead of the model's scheme", NULL, NULL},
+    {"--rtol", REAL, AT(rtol), "relative tolerance of --reference (default 1e-12)", NULL, between_0_and_1},
+    {"--repeat", INTEGER, AT(repeat), "solve this many times and report the median cpu_seconds (default 1; for timing)", NULL, repeat_count},
+    {"--quiet", FLAG, AT(quiet), "no progress line on a terminal", NULL, NULL},
 };
 #define N_OPTIONS (sizeof table / sizeof table[0])
+typedef char options_fit_in_typed[N_OPTIONS <= N_OPTIONS_MAX ? 1 : -1];
 
 static void usage(FILE *out)
 {
@@ -82,11 +123,22 @@ static void usage(FILE *out)
     fprintf(out, "  %-18s %s\n", "--list-options", "print this table as JSON (option, kind, help, choices) and exit");
     fprintf(out, "  %-18s %s\n\n", "--help", "this text");
     fprintf(out,
-            "Output (table, or --json keys): F_peak [N], eps, t_contact [s], x_perm [m], E_diss [J],\n"
-            "v_end [m/s], x_end [m], x1_end [m] (striker velocity, total and elastic indentation where\n"
-            "the solve stopped),\n"
-            "steps (internal steps; the reference: right-hand-side evaluations), cpu_seconds (of the\n"
-            "solve alone), impacts, separated, t_end [s] (where the solve stopped).\n"
+            "The solve stops at the first of: --impacts impacts ended, --t-end, or the striker out of\n"
+            "contact moving away with nothing to bring it back (no gravity, say).\n\n"
+            "Output (table, or --json keys):\n"
+            "  per_impact   one entry for every finished impact, in order: t_onset [s], v_onset [m/s],\n"
+            "               F_peak [N], eps, t_contact [s], x2_end [m] (the permanent indentation when it\n"
+            "               ended, left by all impacts so far), E_diss [J] (dissipated during it)\n"
+            "  F_peak [N]   the largest force of the whole solve (all impacts, and a contact still going)\n"
+            "  eps, t_contact [s]   of the last finished impact (0 when none ended)\n"
+            "  x_perm [m], E_diss [J]   permanent indentation and energy dissipated where the solve\n"
+            "               stopped, summed over every impact\n"
+            "  v_end [m/s], x_end [m], x1_end [m]   striker velocity, total and elastic indentation there\n"
+            "  impacts      finished impacts; separated: whether any impact ended\n"
+            "  stopped      why the solve stopped: impacts, t_end or receding\n"
+            "  t_end [s]    where it stopped\n"
+            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
+            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
             "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
 }
 
@@ -133,9 +185,10 @@ static void list_options(void)
     printf("\n]\n");
 }
 
+/* Names the option and its value exactly as typed. */
 static int bad_option(const char *name, const char *value, const char *why)
 {
-    fprintf(stderr, PROGRAM ": %s '%s': %s (see --help)\n", name, value, why);
+    fprintf(stderr, PROGRAM ": %s '%s'%s: %s (see --help)\n", name, value, *value ? "" : " (empty)", why);
     return 2;
 }
 
@@ -156,15 +209,17 @@ static int parse_word(const char *value, const char *const words[], int *out)
     return -1;
 }
 
+/* Reads the value into its field; 0, or 2 after a message. */
 static int set_option(options *o, const option *opt, const char *value)
 {
     char *at = (char *)o + opt->offset, *end;
+    const char *broken;
     switch (opt->kind) {
     case REAL:
         *(double *)at = strtod(value, &end);
         if (!*value || *end)
             return bad_option(opt->name, value, "not a number");
-        return 0;
+        break;
     case INTEGER: {
         long n = strtol(value, &end, 10);
         if (!*value || *end)
@@ -172,7 +227,7 @@ static int set_option(options *o, const option *opt, const char *value)
         if (n < -2147483647L || n > 2147483647L)
             return bad_option(opt->name, value, "out of range");
         *(int *)at = (int)n;
-        return 0;
+        break;
     }
     case LAW:
         return parse_word(value, law_words, (int *)at) ? bad_option(opt->name, value, "one of g1, hertz, g1x") : 0;
@@ -182,20 +237,48 @@ static int set_option(options *o, const option *opt, const char *value)
         return parse_word(value, scene_words, (int *)at) ? bad_option(opt->name, value, "one of drop, driven") : 0;
     case TEXT:
         *(const char **)at = value;
-        return 0;
+        break;
     case FLAG:
         *(int *)at = 1;
-        return 0;
+        break;
     }
-    return 0;
+    broken = opt->rule ? opt->rule(at) : NULL;
+    return broken ? bad_option(opt->name, value, broken) : 0;
 }
 
-/* Returns 0, 2 for bad options, or -1 after --help. */
+/* The model's own checks; its message names its variable, which names the
+ * option and the value as typed. */
+static int check_model(const options *o)
+{
+    char why[300];
+    size_t k, n;
+    if (contact_check_params(&o->p, why, sizeof why) == 0
+        && contact_check_striker(o->p.scene, o->v0, o->m, why, sizeof why) == 0)
+        return 0;
+    n = strcspn(why, " ");
+    for (k = 0; k < N_OPTIONS; k++)
+        if (o->typed[k] && table[k].variable && strlen(table[k].variable) == n
+            && strncmp(why, table[k].variable, n) == 0)
+            return bad_option(table[k].name, o->typed[k], why);
+    fprintf(stderr, PROGRAM ": %s (see --help)\n", why);
+    return 2;
+}
+
+static const char *typed_value(const options *o, const char *name)
+{
+    size_t k;
+    for (k = 0; k < N_OPTIONS; k++)
+        if (strcmp(table[k].name, name) == 0)
+            return o->typed[k];
+    return NULL;
+}
+
+/* Returns 0, 2 for bad options, or -1 after --help or --list-options. */
 static int parse(int argc, char **argv, options *o)
 {
     int i;
     size_t k;
-    char why[300];
+    char warning[512];
     for (i = 1; i < argc; i++) {
         char name[64];
         const char *value = NULL, *eq = strchr(argv[i], '=');
@@ -217,35 +300,23 @@ static int parse(int argc, char **argv, options *o)
         if (opt->kind == FLAG) {
             if (eq)
                 return bad_option(name, eq + 1, "takes no value");
+            value = "";
         } else if (eq)
             value = eq + 1;
         else if (i + 1 < argc)
             value = argv[++i];
         else
             return bad_option(name, "", "needs a value");
-        if (set_option(o, opt, value ? value : "") != 0)
+        if (set_option(o, opt, value) != 0)
             return 2;
+        o->typed[opt - table] = value;
     }
-    if (o->height != -1.0) { /* -1: not given */
-        if (!(o->height >= 0.0) || !isfinite(o->height))
-            return bad_option("--height", "", "must be finite and >= 0");
+    if (typed_value(o, "--height"))
         o->v0 = sqrt(2.0 * G_EARTH * o->height);
-    }
-    if (contact_check_params(&o->p, why, sizeof why) != 0
-        || contact_check_striker(o->p.scene, o->v0, o->m, why, sizeof why) != 0) {
-        fprintf(stderr, PROGRAM ": %s (see --help)\n", why);
+    if (check_model(o) != 0)
         return 2;
-    }
-    if (!(o->t_end > 0.0) || !isfinite(o->t_end))
-        return bad_option("--t-end", "", "must be positive and finite");
-    if (o->impacts < 1)
-        return bad_option("--impacts", "", "must be >= 1");
-    if (!(o->output_interval >= 0.0) || !isfinite(o->output_interval))
-        return bad_option("--output-interval", "", "must be >= 0 and finite");
-    if (o->repeat < 1 || o->repeat > 100000)
-        return bad_option("--repeat", "", "must lie in 1..100000");
-    if (!(o->rtol > 0.0 && o->rtol < 1.0))
-        return bad_option("--rtol", "", "must lie in (0, 1)");
+    if (contact_unused_material(&o->p, warning, sizeof warning))
+        fprintf(stderr, PROGRAM ": warning: %s\n", warning);
     return 0;
 }
 
@@ -261,10 +332,11 @@ typedef struct {
     int failed;
 } series;
 
+/* A row, unless it repeats the last one's time (an event on an output time). */
 static void keep(void *ctx, double t, double F, double x, double x1, double x2, double v, double E_diss)
 {
     series *s = ctx;
-    if (s->failed)
+    if (s->failed || (s->n > 0 && !(t > s->rows[s->n - 1].t)))
         return;
     if (s->n == s->cap) {
         size_t cap = s->cap ? 2 * s->cap : 4096;
@@ -326,67 +398,147 @@ static int write_csv(const char *path, const series *s)
 
 typedef struct {
     double F_peak, eps, t_contact, x_perm, E_diss, v_end, x_end, x1_end, cpu_seconds, t_end;
-    long steps, impacts;
+    int64_t steps, impacts;
+    int stop;                /* enum run_stop */
+    impact_list per_impact;
 } figures;
 
-static void print_results(const options *o, const figures *f, double k)
+static void print_json(const options *o, const figures *f, double k)
 {
     static const char *const laws[] = {"", "g1", "hertz", "g1x"};
     static const char *const schemes[] = {"", "sdirk2", "central"};
-    const char *method = o->reference ? "reference" : schemes[o->p.scheme];
-    if (o->json) {
-        printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
-               "\"E_diss\": %.17g, \"v_end\": %.17g, \"x_end\": %.17g, \"x1_end\": %.17g, "
-               "\"steps\": %ld, \"cpu_seconds\": %.9g, "
-               "\"impacts\": %ld, \"separated\": %s, \"t_end\": %.17g, \"law\": \"%s\", "
-               "\"method\": \"%s\", \"dt\": %.17g, \"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g}\n",
-               f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->x_end, f->x1_end, f->steps,
-               f->cpu_seconds,
-               f->impacts, f->impacts > 0 ? "true" : "false", f->t_end, laws[o->p.law], method,
-               o->p.dt_max, k, o->p.c, o->m, o->v0);
-        return;
+    size_t i;
+    printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
+           "\"E_diss\": %.17g, \"v_end\": %.17g, \"x_end\": %.17g, \"x1_end\": %.17g, "
+           "\"steps\": %" PRId64 ", \"cpu_seconds\": %.9g, \"impacts\": %" PRId64 ", \"separated\": %s, "
+           "\"stopped\": \"%s\", \"t_end\": %.17g, \"law\": \"%s\", \"method\": \"%s\", \"dt\": %.17g, "
+           "\"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g, \"per_impact\": [",
+           f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->x_end, f->x1_end, f->steps,
+           f->cpu_seconds, f->impacts, f->impacts > 0 ? "true" : "false", run_stop_name(f->stop), f->t_end,
+           laws[o->p.law], o->reference ? "reference" : schemes[o->p.scheme], o->p.dt_max, k, o->p.c, o->m, o->v0);
+    for (i = 0; i < f->per_impact.n; i++) {
+        const impact_figures *p = &f->per_impact.list[i];
+        printf("%s{\"t_onset\": %.17g, \"v_onset\": %.17g, \"F_peak\": %.17g, \"eps\": %.17g, "
+               "\"t_contact\": %.17g, \"x2_end\": %.17g, \"E_diss\": %.17g}",
+               i ? ", " : "", p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
     }
-    printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v0 = %.6g m/s\n", method,
-           laws[o->p.law], k, o->p.c, o->m, o->v0);
-    printf("  F_peak     %.10g N\n", f->F_peak);
-    printf("  eps        %.10g\n", f->eps);
-    printf("  t_contact  %.10g s\n", f->t_contact);
-    printf("  x_perm     %.10g m\n", f->x_perm);
-    printf("  E_diss     %.10g J\n", f->E_diss);
+    printf("]}\n");
+}
+
+static void print_table(const options *o, const figures *f, double k)
+{
+    static const char *const laws[] = {"", "g1", "hertz", "g1x"};
+    static const char *const schemes[] = {"", "sdirk2", "central"};
+    static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
+                                        "the striker moves away and nothing brings it back"};
+    size_t i;
+    printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v0 = %.6g m/s\n",
+           o->reference ? "reference" : schemes[o->p.scheme], laws[o->p.law], k, o->p.c, o->m, o->v0);
+    if (f->per_impact.n > 0) {
+        printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");
+        for (i = 0; i < f->per_impact.n; i++) {
+            const impact_figures *p = &f->per_impact.list[i];
+            printf("  %6lu  %11.6g  %13.6g  %10.6g  %9.6g  %13.6g  %10.6g  %10.6g\n", (unsigned long)(i + 1),
+                   p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
+        }
+    }
+    printf("  F_peak     %.10g N (largest of the solve)\n", f->F_peak);
+    printf("  eps        %.10g (last finished impact)\n", f->eps);
+    printf("  t_contact  %.10g s (last finished impact)\n", f->t_contact);
+    printf("  x_perm     %.10g m (where the solve stopped)\n", f->x_perm);
+    printf("  E_diss     %.10g J (all impacts)\n", f->E_diss);
     printf("  v_end      %.10g m/s\n", f->v_end);
-    printf("  impacts    %ld%s (t = %.6g s)\n", f->impacts, f->impacts > 0 ? "" : ", no separation by --t-end",
-           f->t_end);
-    printf("  steps      %ld\n", f->steps);
+    printf("  impacts    %" PRId64 "\n", f->impacts);
+    printf("  stopped    at t = %.6g s: %s\n", f->t_end, stops[f->stop]);
+    printf("  steps      %" PRId64 "\n", f->steps);
     printf("  cpu        %.6g s\n", f->cpu_seconds);
 }
 
 /* ------------------------------------------------------------ the solves */
 
-static int solve_model(const options *o, series *out, figures *f)
+/* The elastic Hertz contact time over x_ref / v (MODEL.md §2: 2.943...), to
+ * the precision a row spacing needs. */
+#define ELASTIC_CONTACT_TIME 2.94
+
+static double default_output_interval(const options *o)
 {
     contact_model cm;
-    double chunk = o->output_interval > 0.0 ? o->output_interval : o->p.dt_max, t0;
+    double x_ref, t_ref;
+    if (o->p.scene == CONTACT_SCENE_DRIVEN && !(o->m > 0.0)) /* one contact, as long as the run */
+        return o->t_end / 1000.0;
+    contact_start(&cm, &o->p, o->v0, o->m);
+    contact_scales(&o->p, contact_spring_stiffness(&cm, 0), o->v0, o->m, &x_ref, &t_ref);
+    return t_ref > 0.0 ? ELASTIC_CONTACT_TIME * t_ref / 256.0 : o->t_end / 1000.0;
+}
+
+/* Rows at the output times k * interval in (before->s.t, t], each the model
+ * advanced from `before` to that time: what the rows show never changes the
+ * steps the solve takes. */
+static void keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
+{
+    for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
+        contact_model at = *before;
+        double tau = (double)*k * interval - before->s.t;
+        if (tau > 0.0 && isnan(contact_advance(&at, tau)))
+            return;
+        keep_state(out, &at);
+    }
+}
+
+static int why_stop(const options *o, const contact_model *cm)
+{
+    if (cm->s.impacts >= o->impacts)
+        return RUN_STOP_IMPACTS;
+    if (cm->s.t >= o->t_end)
+        return RUN_STOP_T_END;
+    return contact_never_returns(cm) ? RUN_STOP_RECEDING : 0;
+}
+
+/* The model as the FMU drives it: in contact one internal step at a time,
+ * free flight in one exact step, stopping at every onset and separation, so
+ * that no figure depends on the output interval. */
+static int solve_model(const options *o, double interval, series *out, figures *f)
+{
+    contact_model cm;
+    double E_diss_onset = 0.0, t0, shown;
+    int64_t k = 1;
     int progress = !o->quiet && !o->json && isatty(STDERR_FILENO);
-    double shown = cpu_seconds();
     contact_start(&cm, &o->p, o->v0, o->m);
     if (out)
         keep_state(out, &cm);
-    t0 = cpu_seconds();
-    /* Stop short of t_end by rounding only, not by a sliver of a step. */
-    while (cm.s.impacts < o->impacts && cm.s.t < o->t_end - 1e-6 * chunk) {
-        double H = fmin(chunk, o->t_end - cm.s.t);
-        if (isnan(contact_advance(&cm, H))) {
+    t0 = shown = cpu_seconds();
+    while (!(f->stop = why_stop(o, &cm))) {
+        const contact_model before = cm;
+        double H = o->t_end - cm.s.t;
+        if (cm.s.in_contact || o->p.scheme == CONTACT_SCHEME_CENTRAL)
+            H = fmin(H, o->p.dt_max);
+        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
             fprintf(stderr, PROGRAM ": the state became non-finite near t = %.9g s\n", cm.s.t);
             return -1;
         }
-        if (out)
-            keep_state(out, &cm);
+        if (cm.s.in_contact && !before.s.in_contact)
+            E_diss_onset = before.s.E_diss;
+        if (cm.s.impacts > before.s.impacts) {
+            impact_figures done = {cm.s.t_onset, cm.s.v_onset, cm.s.F_peak_contact, cm.s.eps,
+                                   cm.s.t_contact, cm.s.x2, cm.s.E_diss - E_diss_onset};
+            if (impact_list_add(&f->per_impact, &done) != 0) {
+                fprintf(stderr, PROGRAM ": out of memory for the per-impact figures\n");
+                return -1;
+            }
+        }
+        if (out) {
+            keep_rows_until(out, &before, cm.s.t, interval, &k);
+            if (interval == 0.0 || cm.s.in_contact != before.s.in_contact)
+                keep_state(out, &cm);
+        }
         if (progress && (cm.s.steps & 0xffff) == 0 && cpu_seconds() - shown > 0.5) {
             shown = cpu_seconds();
-            fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %ld steps, %ld of %ld impacts   ", cm.s.t, o->t_end,
-                    cm.s.steps, cm.s.impacts, (long)o->impacts);
+            fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " steps, %" PRId64 " of %d impacts   ",
+                    cm.s.t, o->t_end, cm.s.steps, cm.s.impacts, o->impacts);
         }
     }
+    if (out)
+        keep_state(out, &cm);
     if (progress && shown > t0)
         fprintf(stderr, "\n");
     f->cpu_seconds = cpu_seconds() - t0;
@@ -404,13 +556,13 @@ static int solve_model(const options *o, series *out, figures *f)
     return 0;
 }
 
-static int solve_reference(const options *o, series *out, figures *f)
+static int solve_reference(const options *o, double interval, series *out, figures *f)
 {
     reference_result r;
     char why[300];
     double t0 = cpu_seconds();
-    if (reference_solve(&o->p, o->v0, o->m, o->rtol, o->t_end, o->impacts, o->output_interval, out ? keep : NULL, out, &r,
-                        why, sizeof why) != 0) {
+    if (reference_solve(&o->p, o->v0, o->m, o->rtol, o->t_end, o->impacts, interval, out ? keep : NULL, out,
+                        &f->per_impact, &r, why, sizeof why) != 0) {
         fprintf(stderr, PROGRAM ": %s\n", why);
         return -1;
     }
@@ -426,23 +578,25 @@ static int solve_reference(const options *o, series *out, figures *f)
     f->steps = r.rhs_evaluations;
     f->impacts = r.impacts;
     f->t_end = r.t;
+    f->stop = r.stop;
     return 0;
 }
 
 /* One solve, or --repeat of them with the median CPU time; the series is
  * kept from the first only. */
-static int solve(const options *o, series *out, figures *f)
+static int solve(const options *o, double interval, series *out, figures *f)
 {
     double *times = malloc((size_t)o->repeat * sizeof *times);
     int i, status = times ? 0 : -1;
     for (i = 0; i < o->repeat && status == 0; i++) {
-        status = o->reference ? solve_reference(o, i == 0 ? out : NULL, f) : solve_model(o, i == 0 ? out : NULL, f);
+        f->per_impact.n = 0;
+        status = o->reference ? solve_reference(o, interval, i == 0 ? out : NULL, f)
+                              : solve_model(o, interval, i == 0 ? out : NULL, f);
         if (times)
             times[i] = f->cpu_seconds;
     }
-    if (status == 0) {
+    if (status == 0)
         f->cpu_seconds = median(times, o->repeat);
-    }
     free(times);
     return status;
 }
@@ -453,13 +607,13 @@ int main(int argc, char **argv)
     figures f;
     series s = {NULL, 0, 0, 0};
     contact_model cm;
+    double interval;
     int status;
     memset(&o, 0, sizeof o);
     memset(&f, 0, sizeof f);
     contact_default_params(&o.p);
     o.v0 = 0.626418;
     o.m = 0.7437;
-    o.height = -1.0;
     o.t_end = 1.0;
     o.impacts = 1;
     o.repeat = 1;
@@ -467,7 +621,8 @@ int main(int argc, char **argv)
     status = parse(argc, argv, &o);
     if (status != 0)
         return status < 0 ? 0 : status;
-    status = solve(&o, o.csv ? &s : NULL, &f);
+    interval = typed_value(&o, "--output-interval") ? o.output_interval : default_output_interval(&o);
+    status = solve(&o, interval, o.csv ? &s : NULL, &f);
     if (status == 0 && s.failed) {
         fprintf(stderr, PROGRAM ": out of memory for the --csv series\n");
         status = -1;
@@ -475,9 +630,13 @@ int main(int argc, char **argv)
     if (status == 0 && o.csv && write_csv(o.csv, &s) != 0)
         status = -1;
     free(s.rows);
-    if (status != 0)
-        return 1;
-    contact_start(&cm, &o.p, o.v0, o.m);
-    print_results(&o, &f, cm.k);
-    return 0;
+    if (status == 0) {
+        contact_start(&cm, &o.p, o.v0, o.m);
+        if (o.json)
+            print_json(&o, &f, cm.k);
+        else
+            print_table(&o, &f, cm.k);
+    }
+    impact_list_free(&f.per_impact);
+    return status == 0 ? 0 : 1;
 }

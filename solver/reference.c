@@ -120,16 +120,47 @@ static int is_stiff(const ode *o, double v0, double x_ref)
     return !(v0 > 0.0 && lambda * x_ref / v0 < 100.0);
 }
 
+/* Whether the striker, out of contact at y, never comes back (the model's
+ * own test, on the reference's state). */
+static int never_returns(contact_model *cm, const double y[4])
+{
+    cm->s.x1 = y[0];
+    cm->s.v = y[1];
+    cm->s.in_contact = 0;
+    return contact_never_returns(cm);
+}
+
+/* Samples at k out_dt in (t, t1], integrated from the bracket's start; their
+ * right-hand-side evaluations are not the solve's. */
+static void sample_until(integrator *in, double t, const double y[4], double t1, double out_dt, long *k,
+                         reference_sample sample, void *ctx)
+{
+    long evaluations = in->o->evaluations;
+    for (; out_dt > 0.0 && (double)*k * out_dt <= t1; ++*k) {
+        double tk = (double)*k * out_dt, yk[4];
+        integrate(in, t, y, tk, yk);
+        sample(ctx, tk, force(in->o, yk[0]), yk[0] + yk[2], yk[0] > 0.0 ? yk[0] : 0.0, yk[2], yk[1], yk[3]);
+    }
+    in->o->evaluations = evaluations;
+}
+
+static void sample_state(const ode *o, double t, const double y[4], reference_sample sample, void *ctx)
+{
+    sample(ctx, t, force(o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+}
+
 int reference_solve(const contact_params *p, double v0, double m, double rtol, double t_end,
                     long impacts, double out_dt, reference_sample sample, void *ctx,
-                    reference_result *r, char *msg, size_t len)
+                    impact_list *per_impact, reference_result *r, char *msg, size_t len)
 {
     contact_model cm;
     ode o;
     integrator in;
     gsl_odeiv2_system sys;
-    double scale[4], x_ref, y[4], y1[4], t = 0.0, next_sample = 0.0, v_onset = v0, t_onset = 0.0;
-    int in_contact;
+    double scale[4], x_ref, t_ref, bracket, y[4], y1[4], t = 0.0;
+    double v_onset = v0, t_onset = 0.0, E_diss_onset = 0.0, F_peak_contact = 0.0;
+    long k = 1;
+    int in_contact, out_of_memory = 0;
     gsl_error_handler_t *previous = gsl_set_error_handler_off();
 
     contact_start(&cm, p, v0, m);
@@ -142,15 +173,14 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
 
     /* Tolerance scales: the Hertz indentation of the impact, or the
      * indentation at which the dashpot takes over a driven rate. */
-    x_ref = o.inv_m > 0.0 ? pow(1.25 * v0 * v0 / (o.inv_m * o.K), 0.4) : pow(fabs(v0) * p->c / o.K, 2.0 / 3.0);
+    contact_scales(p, o.K, v0, m, &x_ref, &t_ref);
     if (!(x_ref > 0.0) || !isfinite(x_ref))
         x_ref = p->gap0 > 0.0 ? p->gap0 : 1e-6;
     scale[0] = scale[2] = 1e-3 * x_ref;
     scale[1] = 1e-3 * (fabs(v0) > 0.0 ? fabs(v0) : sqrt(fabs(p->g) * x_ref) + 1e-9);
     scale[3] = 1e-3 * o.K * pow(x_ref, 2.5);
-    r->stiff = is_stiff(&o, fabs(v0), x_ref);
-    if (!(out_dt > 0.0)) /* events are bracketed per output interval: 1/64 of the contact's time scale */
-        out_dt = fabs(v0) > 0.0 ? x_ref / fabs(v0) / 64.0 : 1e-6;
+    r->stiff = is_stiff(&o, t_ref > 0.0 ? x_ref / t_ref : fabs(v0), x_ref);
+    bracket = t_ref > 0.0 ? t_ref / 64.0 : 1e-6;
 
     sys.function = rhs;
     sys.jacobian = jacobian;
@@ -171,46 +201,66 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     y[1] = v0;
     y[2] = y[3] = 0.0;
     in_contact = y[0] >= 0.0 && (v0 > 0.0 || (v0 == 0.0 && o.accel > 0.0));
-    while (r->impacts < impacts && t < t_end && in.status == GSL_SUCCESS) {
-        double t1 = next_sample < t_end ? next_sample : t_end;
-        if (t1 <= t) {
-            if (sample)
-                sample(ctx, t, force(&o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
-            next_sample += out_dt;
-            continue;
-        }
+    if (sample)
+        sample_state(&o, t, y, sample, ctx);
+    while (in.status == GSL_SUCCESS && !out_of_memory) {
+        double t1;
+        int event = 0;
+        r->stop = r->impacts >= impacts ? RUN_STOP_IMPACTS
+                  : t >= t_end          ? RUN_STOP_T_END
+                  : !in_contact && never_returns(&cm, y) ? RUN_STOP_RECEDING
+                                                          : 0;
+        if (r->stop)
+            break;
+        t1 = fmin(t + bracket, t_end);
         integrate(&in, t, y, t1, y1);
         if (!in_contact && y1[0] > 0.0) {           /* onset inside (t, t1] */
             t1 = event_time(&in, t, y, t1, 0);
             integrate(&in, t, y, t1, y1);
             y1[0] = 0.0;
-            in_contact = 1;
+            in_contact = event = 1;
             v_onset = y1[1];
             t_onset = t1;
+            E_diss_onset = y1[3];
+            F_peak_contact = 0.0;
         } else if (in_contact) {
             if (event_value(&o, 1, y) > 0.0 && event_value(&o, 1, y1) <= 0.0) { /* the force peaks */
                 double tp = event_time(&in, t, y, t1, 1), yp[4];
                 integrate(&in, t, y, tp, yp);
-                if (force(&o, yp[0]) > r->F_peak)
-                    r->F_peak = force(&o, yp[0]);
+                F_peak_contact = fmax(F_peak_contact, force(&o, yp[0]));
             }
             if (y1[0] <= 0.0) {                      /* separation inside (t, t1] */
+                impact_figures done;
                 t1 = event_time(&in, t, y, t1, 0);
                 integrate(&in, t, y, t1, y1);
                 y1[0] = 0.0;
                 in_contact = 0;
+                event = 1;
                 r->impacts++;
                 r->eps = v_onset > 0.0 ? -y1[1] / v_onset : 0.0;
                 r->t_contact = t1 - t_onset;
+                done.t_onset = t_onset;
+                done.v_onset = v_onset;
+                done.F_peak = F_peak_contact;
+                done.eps = r->eps;
+                done.t_contact = r->t_contact;
+                done.x2_end = y1[2];
+                done.E_diss = y1[3] - E_diss_onset;
+                out_of_memory = impact_list_add(per_impact, &done) != 0;
             }
+            F_peak_contact = fmax(F_peak_contact, force(&o, y1[0]));
         }
-        if (force(&o, y1[0]) > r->F_peak)
-            r->F_peak = force(&o, y1[0]);
+        r->F_peak = fmax(r->F_peak, F_peak_contact);
+        if (sample) {
+            sample_until(&in, t, y, t1, out_dt, &k, sample, ctx);
+            if (event || out_dt == 0.0)
+                sample_state(&o, t1, y1, sample, ctx);
+        }
         t = t1;
         memcpy(y, y1, sizeof y);
     }
     if (sample)
-        sample(ctx, t, force(&o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
+        sample_state(&o, t, y, sample, ctx);
     r->t = t;
     r->v = y[1];
     r->x1 = y[0] > 0.0 ? y[0] : 0.0;
@@ -220,6 +270,10 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     r->rhs_evaluations = o.evaluations;
     gsl_odeiv2_driver_free(in.driver);
     gsl_set_error_handler(previous);
+    if (out_of_memory) {
+        snprintf(msg, len, "reference: out of memory for the per-impact figures");
+        return -1;
+    }
     if (in.status != GSL_SUCCESS) {
         snprintf(msg, len, "reference: GSL's integrator failed at t = %.9g s (%s)", t, gsl_strerror(in.status));
         return -1;

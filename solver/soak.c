@@ -9,6 +9,7 @@
  *                                     the specimen, through the FMU (dt_max = 1e-6 s) */
 #define _POSIX_C_SOURCE 200809L
 
+#include <inttypes.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -182,7 +183,7 @@ static int steps(double target)
     for (i = 0; i < k; i++)
         if (rss[i] > max_rss)
             max_rss = rss[i];
-    printf("{\"internal_steps\": %ld, \"impacts\": %ld, \"simulated_seconds\": %.3f, \"wall_seconds\": %.1f, "
+    printf("{\"internal_steps\": %" PRId64 ", \"impacts\": %" PRId64 ", \"simulated_seconds\": %.3f, \"wall_seconds\": %.1f, "
            "\"rss_mib_samples\": [", cm.s.steps, cm.s.impacts, cm.s.t, wall_now() - t0);
     for (i = 0; i < k; i++)
         printf("%s%.2f", i ? ", " : "", rss[i]);

@@ -15,6 +15,11 @@ M = 0.7437
 K = 3.299e8
 C = 6080.0
 
+# fmpy's native logger proxy keeps the last callback it was given in a global,
+# which a later FMU that logs (a warning from fmpy.simulate_fmu, say) calls:
+# so no callback handed to it may be freed before the process ends.
+_PROXIED_CALLBACKS = []
+
 
 class Slave:
     """One instance of the FMU, set, read and stepped by variable name.
@@ -32,6 +37,7 @@ class Slave:
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(self.callbacks))
+        _PROXIED_CALLBACKS.append(self.callbacks)
         self.fmu = FMU2Slave(guid=model_description.guid, unzipDirectory=unzipped,
                              modelIdentifier=model_description.coSimulation.modelIdentifier,
                              instanceName="test")

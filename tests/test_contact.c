@@ -1,6 +1,7 @@
 /* The contact model against identities that hold whatever its step:
  * momentum, energy, closed forms, order of convergence, stability. */
 #include <float.h>
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -174,7 +175,7 @@ static void test_gap_and_gravity(void)
     /* It bounces and lands again: repeated impacts under gravity. */
     while (cm.s.impacts < 3 && cm.s.t < 1.0)
         contact_advance(&cm, 1e-5);
-    CHECK(cm.s.impacts == 3, "3 impacts by t = %g s, got %ld", cm.s.t, cm.s.impacts);
+    CHECK(cm.s.impacts == 3, "3 impacts by t = %g s, got %" PRId64, cm.s.t, cm.s.impacts);
 }
 
 int main(void)

@@ -101,3 +101,34 @@ def test_wrong_call_order_is_an_error_not_a_crash(slave):
     assert "does not match" in s.last_error()
     s.step(1e-5)  # still usable
     assert s.get("F") > 0.0
+
+
+MATERIALS = {"R": 1e-2, "E_i": 70e9, "nu_i": 0.25, "E_s": 1.2e9, "nu_s": 0.35}
+
+
+@pytest.mark.parametrize("name", sorted(MATERIALS))
+def test_a_material_without_effect_warns_at_the_end_of_initialization(slave, name):
+    """With k != 0, k wins: a material set away from its default changes
+    nothing, so fmi2ExitInitializationMode says so (fmi2Warning, naming it
+    and its value) and the simulation goes on with the given k."""
+    s = slave(start=False, **{name: MATERIALS[name]})
+    s.enter()
+    assert s.fmu.exitInitializationMode() == 1  # fmi2Warning
+    warnings = [m for status, category, m in s.log if status == 1]
+    assert len(warnings) == 1 and f"{name} = {MATERIALS[name]:g}" in warnings[0], s.log
+    assert "k = 3.299e+08" in warnings[0] and "no effect" in warnings[0]
+    assert_stepping_matches_the_default(s)
+
+
+def assert_stepping_matches_the_default(s):
+    for _ in range(200):
+        s.step(1e-5)
+    assert s.get("eps") == pytest.approx(0.58606378, rel=1e-7, abs=0)  # the h20 default (README)
+
+
+def test_no_warning_with_k_0_or_default_materials(slave):
+    for values in ({}, {"k": 0.0, "E_s": 1.2e9}):
+        s = slave(start=False, **values)
+        s.enter()
+        assert s.fmu.exitInitializationMode() == 0
+        assert not [m for status, category, m in s.log if status == 1], s.log

@@ -136,3 +136,24 @@ def test_restoring_a_state_from_before_initialization_goes_back_there(slave):
     s.t = 0.0
     s.start()
     s.step(H)
+
+
+@pytest.mark.parametrize("mode", [0, 3, 8, 32, 64, 1 << 31])
+def test_a_state_in_a_mode_the_fmu_never_enters_is_refused(slave, mode):
+    """The slave has the modes instantiated (1), initialization (2), step
+    complete (4) and terminated (16) only: no stepFailed (8) or error (32)
+    state is ever entered, so a state that claims one (re-checksummed, as a
+    crafted or buggy master might) is refused and the instance goes on."""
+    import zlib
+    s = slave()
+    run(s, 3)
+    blob = bytearray(s.fmu.serializeFMUstate(s.fmu.getFMUstate()))
+    blob[20:24] = struct.pack("<I", mode)
+    blob[16:20] = struct.pack("<I", zlib.crc32(bytes(blob[20:])))
+    state = s.fmu.deSerializeFMUstate(bytes(blob))
+    before = outputs(s)
+    with pytest.raises(FMICallException):
+        s.fmu.setFMUstate(state)
+    assert "impossible mode" in s.last_error()
+    assert outputs(s) == before
+    s.step(H)

@@ -139,3 +139,164 @@ def test_extrapolated_g1_law_is_second_order():
         errors = [abs(solve_json("--law", "g1x", "--dt", dt)[key] / ref[key] - 1) for dt in (4e-7, 2e-7, 1e-7)]
         observed = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
         assert all(abs(p - 2) < 0.15 for p in observed), (key, errors, observed)
+
+
+# ---------------------------------------------------------------- issue 10: the CLI as a user meets it
+
+def without_timing(r):
+    return {key: value for key, value in r.items() if key != "cpu_seconds"}
+
+
+@pytest.mark.parametrize("method", [[], ["--reference"]])
+def test_no_figure_depends_on_the_output_interval(method, tmp_path):
+    """Three bounces under gravity: the solve stops right after the third
+    impact ends whatever the CSV's row spacing, and every figure is the same
+    to the bit (rows are made from copies of the state, never by cutting the
+    solve's own steps)."""
+    runs = []
+    for i, interval in enumerate([None, "0.5", "0.1", "1e-5", "0"]):
+        args = ["--g", 9.81, "--impacts", 3, "--law", "hertz", *method, "--csv", tmp_path / f"{i}.csv"]
+        if interval is not None:
+            args += ["--output-interval", interval]
+        runs.append(without_timing(solve_json(*args)))
+    assert runs[0]["impacts"] == 3 and runs[0]["stopped"] == "impacts"
+    for r in runs[1:]:
+        assert r == runs[0]
+
+
+def test_per_impact_figures_against_the_reference():
+    """Each impact's figures from the model (Hertz law, dt 1e-7) against the
+    GSL reference, impact by impact. The scheme's error at this step is about
+    1e-9 relative for h20 (README: 8.7e-10 in F_peak, 3.3e-9 in eps); free
+    flight is exact, so later impacts inherit only that: 1e-7 leaves two
+    orders of margin and fails any mix-up between impacts (they differ by
+    tens of percent)."""
+    args = ("--g", 9.81, "--impacts", 3, "--law", "hertz")
+    model, ref = solve_json(*args), solve_json(*args, "--reference")
+    assert len(model["per_impact"]) == len(ref["per_impact"]) == 3
+    for a, b in zip(model["per_impact"], ref["per_impact"]):
+        for key in ("t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss"):
+            assert a[key] == pytest.approx(b[key], rel=1e-7, abs=1e-7 * abs(b["t_contact"]) if key == "t_onset" else 0), key
+
+
+@pytest.mark.parametrize("method", [[], ["--reference"]])
+def test_top_level_figures_say_which_impact_they_describe(method):
+    """F_peak is the largest of all impacts; eps and t_contact the last one's;
+    E_diss the sum; x_perm the dent where the solve stopped: identities on the
+    per-impact list."""
+    r = solve_json("--g", 9.81, "--impacts", 3, *method)
+    impacts = r["per_impact"]
+    assert [i["F_peak"] for i in impacts] == sorted((i["F_peak"] for i in impacts), reverse=True)
+    assert r["F_peak"] == max(i["F_peak"] for i in impacts)
+    assert r["eps"] == impacts[-1]["eps"] and r["t_contact"] == impacts[-1]["t_contact"]
+    assert r["x_perm"] == impacts[-1]["x2_end"]
+    assert r["E_diss"] == pytest.approx(sum(i["E_diss"] for i in impacts), rel=1e-13, abs=0)
+    # each impact starts where the last left off: its onset speed is the rebound falling back under g
+    for a, b in zip(impacts, impacts[1:]):
+        assert b["v_onset"] == pytest.approx(a["eps"] * a["v_onset"], rel=1e-9, abs=0)
+    help_text = solve("--help").stdout
+    for words in ("per_impact", "largest force of the whole solve", "of the last finished impact", "stopped"):
+        assert words in help_text, words
+
+
+def test_text_output_has_a_per_impact_table():
+    out = solve("--g", 9.81, "--impacts", 3).stdout
+    header = [line for line in out.splitlines() if "t_onset [s]" in line]
+    assert len(header) == 1
+    rows = out.splitlines()[out.splitlines().index(header[0]) + 1:][:3]
+    assert [row.split()[0] for row in rows] == ["1", "2", "3"]
+
+
+def test_one_impact_per_impact_figures_match_the_closed_forms():
+    """Momentum and energy of the one impact of h20 (no gravity):
+    x2_end = m v0 (1 + eps) / c (the dashpot carries the impulse) and
+    E_diss = m v0^2 (1 - eps^2) / 2; the dissipation is counted from each
+    step's mean force, within O(dt^2) ~ 1e-9 of the integral."""
+    r = solve_json("--law", "hertz")
+    (i,) = r["per_impact"]
+    assert i["t_onset"] == 0 and i["v_onset"] == V0
+    assert i["x2_end"] == pytest.approx(M * V0 * (1 + i["eps"]) / C, rel=1e-12, abs=0)
+    assert i["E_diss"] == pytest.approx(0.5 * M * V0 ** 2 * (1 - i["eps"] ** 2), rel=1e-8, abs=0)
+
+
+@pytest.mark.parametrize("height", ["-1", "-1e-3", "nan", "inf", "-inf", "-0.5"])
+def test_a_negative_or_nonfinite_height_is_refused(height):
+    done = solve("--height", height, check=False)
+    assert done.returncode == 2 and f"--height '{height}'" in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--impacts", ""], "--impacts '' (empty)"), (["--height", "nan"], "--height 'nan'"),
+    (["--t-end", "0"], "--t-end '0'"), (["--rtol", "0"], "--rtol '0'"), (["--repeat", "0"], "--repeat '0'"),
+    (["--output-interval", "-1"], "--output-interval '-1'"), (["--c", "-1e0"], "--c '-1e0'"),
+    (["--dt=0.0"], "--dt '0.0'"), (["--m", "-0"], "--m '-0'"), (["--E-s", "-2e9"], "--E-s '-2e9'"),
+    (["--law", "9"], "--law '9'"), (["--impacts", "0"], "--impacts '0'")])
+def test_every_message_names_the_option_and_the_value_as_typed(args, says):
+    done = solve(*args, check=False)
+    assert done.returncode == 2 and says in done.stderr, done.stderr
+
+
+def test_free_flight_is_one_exact_step():
+    """A drop from 1 m above the specimen under gravity: the fall is one
+    step (the CLI used to step it at dt: 4.5 million steps), and the onset
+    time and speed are the free-fall closed forms t = sqrt(2 h / g),
+    v = sqrt(2 g h) to rounding."""
+    g, gap0 = 9.81, 1.0
+    r = solve_json("--g", g, "--gap0", gap0, "--v0", 0, "--law", "hertz")
+    (i,) = r["per_impact"]
+    assert i["t_onset"] == pytest.approx(math.sqrt(2 * gap0 / g), rel=1e-14, abs=0)
+    assert i["v_onset"] == pytest.approx(math.sqrt(2 * g * gap0), rel=1e-14, abs=0)
+    contact_steps = math.ceil(i["t_contact"] / 1e-7)
+    assert r["steps"] <= contact_steps + 2, (r["steps"], contact_steps)
+
+
+@pytest.mark.parametrize("method", [[], ["--reference"]])
+def test_a_receding_striker_stops_the_solve_at_once(method):
+    """Nothing brings a striker that moves away back (no gravity): the solve
+    stops there, says so, and does not run to --t-end."""
+    r = solve_json("--v0", -1, "--t-end", 1e300, *method)
+    assert r["stopped"] == "receding" and r["t_end"] == 0 and r["impacts"] == 0 and r["steps"] <= 1
+    r = solve_json("--impacts", 2, "--t-end", 1e300, *method)
+    assert r["stopped"] == "receding" and r["impacts"] == 1
+    assert r["t_end"] == pytest.approx(r["per_impact"][0]["t_contact"], rel=1e-15, abs=0)
+    assert "nothing brings it back" in solve("--v0", -1, *method).stdout
+
+
+def test_csv_has_a_few_hundred_rows_per_contact_by_default(tmp_path):
+    """h20 lasts 1.3 ms: the default spacing (1/256 of the elastic contact
+    time) gives a few hundred rows; --output-interval 0 asks for every step."""
+    r = solve_json("--csv", tmp_path / "default.csv")
+    rows = list(csv.DictReader(open(tmp_path / "default.csv")))
+    assert 200 <= len(rows) <= 400, len(rows)
+    assert float(rows[-1]["t_s"]) == pytest.approx(r["t_end"], rel=1e-11, abs=0)  # 12 digits written
+    r = solve_json("--csv", tmp_path / "every.csv", "--output-interval", 0)
+    assert len(list(csv.DictReader(open(tmp_path / "every.csv")))) >= r["t_contact"] / 1e-7
+    assert "every internal step" in solve("--help").stdout
+
+
+def test_rows_are_the_model_at_their_times(tmp_path):
+    """A row between steps is the model advanced to that time: with rows
+    every 2.5e-7 s and steps of 1e-7 s, the rows that fall on step ends
+    (every other one: 5e-7) equal the every-step series there (12 digits
+    are written)."""
+    solve_json("--law", "hertz", "--csv", tmp_path / "rows.csv", "--output-interval", 2.5e-7)
+    solve_json("--law", "hertz", "--csv", tmp_path / "steps.csv", "--output-interval", 0)
+    rows = {round(float(r["t_s"]) / 5e-7): r for r in csv.DictReader(open(tmp_path / "rows.csv"))
+            if abs(float(r["t_s"]) / 5e-7 - round(float(r["t_s"]) / 5e-7)) < 1e-6}
+    steps = {round(float(r["t_s"]) / 5e-7): r for r in csv.DictReader(open(tmp_path / "steps.csv"))
+             if abs(float(r["t_s"]) / 5e-7 - round(float(r["t_s"]) / 5e-7)) < 1e-6}
+    common = sorted(set(rows) & set(steps))
+    assert len(common) > 2000
+    for n in common:
+        assert float(rows[n]["F_N"]) == pytest.approx(float(steps[n]["F_N"]), rel=1e-9, abs=1e-9)
+
+
+def test_a_material_without_effect_is_warned_about():
+    done = solve("--E-s", "1.2e9")
+    assert "warning" in done.stderr and "E_s = 1.2e+09 has no effect" in done.stderr, done.stderr
+    assert not solve().stderr
+    # with k = 0 the materials are used: k from the Hertz closed form, no warning
+    done = solve("--k", 0, "--E-s", "1.2e9", "--json")
+    assert not done.stderr
+    e_star = 1 / ((1 - 0.3 ** 2) / 210e9 + (1 - 0.4 ** 2) / 1.2e9)
+    assert json.loads(done.stdout)["k"] == pytest.approx(4 / 3 * e_star * math.sqrt(6.35e-3), rel=1e-15, abs=0)

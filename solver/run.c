@@ -1,0 +1,41 @@
+#include "run.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+int impact_list_add(impact_list *l, const impact_figures *f)
+{
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? 2 * l->cap : 16;
+        impact_figures *grown = realloc(l->list, cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        l->list = grown;
+        l->cap = cap;
+    }
+    l->list[l->n++] = *f;
+    return 0;
+}
+
+void impact_list_free(impact_list *l)
+{
+    free(l->list);
+    l->list = NULL;
+    l->n = l->cap = 0;
+}
+
+const char *run_stop_name(int stop)
+{
+    return stop == RUN_STOP_IMPACTS ? "impacts" : stop == RUN_STOP_T_END ? "t_end" : "receding";
+}
+
+void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref)
+{
+    double g = p->scene == CONTACT_SCENE_DROP || m > 0.0 ? p->g : 0.0;
+    double v2 = v0 * v0 + 2.0 * g * p->gap0, v = v2 > 0.0 ? sqrt(v2) : 0.0;
+    *x_ref = *t_ref = 0.0;
+    if (!(v > 0.0 && (v0 > 0.0 || g > 0.0)))
+        return;
+    *x_ref = m > 0.0 ? pow(1.25 * m * v * v / K, 0.4) : pow(v * p->c / K, 2.0 / 3.0);
+    *t_ref = *x_ref / v;
+}
