@@ -131,6 +131,10 @@ def write_curve(path, t, F, header="t_s,F_N"):
 
 def run_fit(*args, solver=None):
     env = dict(os.environ, **({"FRACCONTACT_SOLVE": solver} if solver else {}))
+    # The sanitizer build preloads ASan into Python for in-process FMUs; a fit
+    # runs no FMU, and matplotlib's C++ exceptions trip ASan's interceptor.
+    # The solver it starts is instrumented on its own (linked with ASan).
+    env.pop("LD_PRELOAD", None)
     return subprocess.run([sys.executable, fit.__file__, *map(str, args)], capture_output=True, text=True,
                           timeout=600, env=env)
 
