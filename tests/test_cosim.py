@@ -25,9 +25,10 @@ def test_mass_aware_gauss_seidel_is_the_monolithic_drop_test(reference, H):
     """The proxy striker is the striker and F_avg its exact impulse: with H
     a multiple of dt_max the runs agree to rounding, whatever the step."""
     r = cosimulate(CONTACT, STRIKER, H, "mass-aware", "gauss-seidel")
-    assert r["F_peak"] == pytest.approx(reference["F_peak"], rel=1e-9)
-    assert r["eps"] == pytest.approx(reference["eps"], rel=1e-9)
-    assert r["energy_error"] == pytest.approx(reference["energy_error"], abs=1e-9)
+    # the same internal steps: only rounding differs (measured 1e-14, README)
+    assert r["F_peak"] == pytest.approx(reference["F_peak"], rel=1e-12, abs=0)
+    assert r["eps"] == pytest.approx(reference["eps"], rel=1e-12, abs=0)
+    assert r["energy_error"] == pytest.approx(reference["energy_error"], rel=0, abs=1e-12)
 
 
 def test_zero_order_hold_converges_and_then_fails(reference):
@@ -35,7 +36,7 @@ def test_zero_order_hold_converges_and_then_fails(reference):
     ~ H^2: 6e-8 at 1e-6 s), off by far at the contact's time scale."""
     small = cosimulate(CONTACT, STRIKER, 1e-6, "zoh", "gauss-seidel")
     large = cosimulate(CONTACT, STRIKER, 1e-3, "zoh", "gauss-seidel")
-    assert small["F_peak"] == pytest.approx(reference["F_peak"], rel=1e-6)
+    assert small["F_peak"] == pytest.approx(reference["F_peak"], rel=2e-7, abs=0)  # 3x the measured 6e-8
     assert abs(large["F_peak"] / reference["F_peak"] - 1) > 0.1
     assert large["energy_error"] > 0.01  # the exchange creates energy
 

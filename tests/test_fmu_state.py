@@ -65,7 +65,7 @@ def test_a_serialized_state_survives_a_file_and_another_process(slave, fmu_path,
         from fmpy import extract, read_model_description
         from fmu_driver import Slave
         md = read_model_description({str(fmu_path)!r})
-        s = Slave(md, extract({str(fmu_path)!r}))
+        s = Slave(md, extract({str(fmu_path)!r}, unzipdir={str(tmp_path / "unzipped")!r}))
         s.fmu.setFMUstate(s.fmu.deSerializeFMUstate(open({str(path)!r}, "rb").read()))
         s.t = {s.t - 50 * H!r}
         for _ in range(50):

@@ -72,19 +72,19 @@ def test_csv_series(tmp_path):
     assert not (tmp_path / "h20.csv.tmp").exists()
     t = [float(row["t_s"]) for row in rows]
     assert t[0] == 0.0 and all(b > a for a, b in zip(t, t[1:]))
-    assert t[1] == pytest.approx(1e-5)
+    assert t[1] == pytest.approx(1e-5, rel=1e-11, abs=0)  # 12 digits are written
     F = [float(row["F_N"]) for row in rows]
     assert max(F) <= r["F_peak"] and max(F) > 0.999 * r["F_peak"]
     for row in rows:  # 12 digits are written
         x, x1, x2 = float(row["x_m"]), float(row["x1_m"]), float(row["x2_m"])
         if x1 > 0:
-            assert x == pytest.approx(x1 + x2, rel=1e-11)
+            assert x == pytest.approx(x1 + x2, rel=1e-11, abs=0)  # three 12-digit numbers, x1, x2 > 0
         else:  # after separation: the gap to the dented surface
             assert x <= x2 * (1 + 1e-11)
 
 
 def test_height_gives_the_impact_velocity():
-    assert solve_json("--height", "0.02")["v0"] == pytest.approx(math.sqrt(2 * 9.81 * 0.02), rel=1e-15)
+    assert solve_json("--height", "0.02")["v0"] == pytest.approx(math.sqrt(2 * 9.81 * 0.02), rel=1e-15, abs=0)
 
 
 def test_reference_matches_scipy():
@@ -94,7 +94,7 @@ def test_reference_matches_scipy():
     ref = reference_drop(K, C, M, V0)
     ref["x_perm"] = ref.pop("x2")
     for key in KEYS:
-        assert r[key] == pytest.approx(ref[key], rel=1e-9), key
+        assert r[key] == pytest.approx(ref[key], rel=1e-9, abs=0), key
 
 
 def test_stiff_reference_matches_scipy_radau():
@@ -105,10 +105,11 @@ def test_stiff_reference_matches_scipy_radau():
     r = solve_json("--reference", "--law", "hertz", "--c", c, "--t-end", t_end)
     ref = solve_drop(K, c, M, V0, method="Radau", rtol=1e-12, t_end=t_end)
     assert r["impacts"] == 0 and not ref["separated"]
-    assert r["x_perm"] == pytest.approx(ref["x2"], rel=1e-8)
-    assert r["v_end"] == pytest.approx(ref["v_end"], rel=1e-8)
-    assert r["E_diss"] == pytest.approx(ref["E_diss"], rel=1e-8)
-    assert r["F_peak"] == pytest.approx(ref["F_peak"], rel=1e-8)
+    # both at rtol 1e-12 on a 10 ms stiff run: 1e-8 allows each 1e-9 of global error, amplified tenfold
+    assert r["x_perm"] == pytest.approx(ref["x2"], rel=1e-8, abs=0)
+    assert r["v_end"] == pytest.approx(ref["v_end"], rel=1e-8, abs=0)
+    assert r["E_diss"] == pytest.approx(ref["E_diss"], rel=1e-8, abs=0)
+    assert r["F_peak"] == pytest.approx(ref["F_peak"], rel=1e-8, abs=0)
 
 
 def test_solver_and_fmu_share_the_model(slave):
@@ -116,9 +117,10 @@ def test_solver_and_fmu_share_the_model(slave):
     for law, name in ((1, "g1"), (2, "hertz")):
         r = solve_json("--law", name)
         f = run_impact(slave(law=law))
-        assert r["F_peak"] == pytest.approx(f["F_peak"], rel=1e-12)
-        assert r["eps"] == pytest.approx(f["eps"], rel=1e-12)
-        assert r["x_perm"] == pytest.approx(f["x2"], rel=1e-12)
+        # the same steps (H a multiple of dt_max): only the rounding of the time sums differs
+        assert r["F_peak"] == pytest.approx(f["F_peak"], rel=1e-12, abs=0)
+        assert r["eps"] == pytest.approx(f["eps"], rel=1e-12, abs=0)
+        assert r["x_perm"] == pytest.approx(f["x2"], rel=1e-12, abs=0)
 
 
 def test_sdirk_is_second_order_and_central_first_against_the_reference():
