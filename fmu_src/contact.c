@@ -449,7 +449,9 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
         }
         K = contact_spring_stiffness(cm, s->n + 1);
         J = sdirk_step(cm, s, h, K, &trial);
-        separates = !(trial.x1 > 0.0);
+        /* Separation is x1 falling to 0 on the way out: an indentation too
+         * small for a double (x1 = v h underflows at v ~ 1e-317) is not one. */
+        separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates) {
             tau = event_time(cm, s, h, K, indentation, trial.x1, &trial);
             J = sdirk_step(cm, s, tau, K, &trial);
