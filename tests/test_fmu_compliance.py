@@ -2,6 +2,7 @@
 simulator and command line, exporting only the FMI functions, rebuildable
 from its sources, and every variable of modelDescription.xml in use."""
 
+import math
 import os
 import subprocess
 import sys
@@ -10,6 +11,9 @@ import zipfile
 import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
+
+EPS = 2.0 ** -52
+GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
 
 
 def test_validate_fmu_finds_no_problem(fmu_path):
@@ -42,7 +46,7 @@ def test_binary_needs_only_libc_and_libm(unzipped):
 def test_default_experiment_shows_impact_and_rebound(fmu_path, model_description):
     de = model_description.defaultExperiment
     result = simulate_fmu(str(fmu_path), output=["F", "eps", "contact"])
-    assert float(de.stopTime) == pytest.approx(3e-3) and float(de.stepSize) == pytest.approx(1e-5)
+    assert float(de.stopTime) == 3e-3 and float(de.stepSize) == 1e-5  # as written in the XML
     assert result["F"].max() > 900.0           # the pulse is there ...
     assert result["F"][-1] == 0.0 and not result["contact"][-1]  # ... and over
     assert 0.5 < result["eps"][-1] < 0.7        # with the paper's rebound
@@ -74,9 +78,13 @@ def test_sources_compile_into_a_working_binary(fmu_path, tmp_path, model_descrip
                     *sources, "-o", str(so), "-lm"], check=True)
     rebuilt = simulate_fmu(str(folder), output=["F_peak", "eps"])
     original = simulate_fmu(str(fmu_path), output=["F_peak", "eps"])
-    # Same source, same compiler: only flag-dependent rounding may differ.
-    assert rebuilt["F_peak"][-1] == pytest.approx(original["F_peak"][-1], rel=1e-12)
-    assert rebuilt["eps"][-1] == pytest.approx(original["eps"][-1], rel=1e-12)
+    # Same source, same compiler: only flag-dependent rounding may differ
+    # (measured: none, the results are bit for bit the same). Where a
+    # compiler rounds an operation differently (an FMA contraction on another
+    # target), the difference walks like sqrt(n) eps = 2.6e-14 over the
+    # n = 13 160 internal steps of the impact: 1e-13 is 4x that.
+    assert rebuilt["F_peak"][-1] == pytest.approx(original["F_peak"][-1], rel=1e-13, abs=0)
+    assert rebuilt["eps"][-1] == pytest.approx(original["eps"][-1], rel=1e-13, abs=0)
 
 
 def test_every_variable_is_read_or_written(slave, model_description):
@@ -98,11 +106,18 @@ def test_every_variable_is_read_or_written(slave, model_description):
         F, F_peak = s.get("F"), s.get("F_peak")
         assert 0.0 <= F <= F_peak
         if s.get("contact"):
-            assert s.get("x") == pytest.approx(s.get("x1") + s.get("x2"), rel=1e-12)
+            # one addition, as the FMU does it (measured: equal)
+            assert s.get("x") == pytest.approx(s.get("x1") + s.get("x2"), rel=EPS, abs=0)
         else:  # the gap to the dented surface
             assert s.get("x") <= s.get("x2") and s.get("x1") == 0.0
-        assert s.get("semi_integral") == pytest.approx(s.get("x1") ** 1.5 / 1.329340388179137, rel=1e-12)
+        # law 2: F / (Gamma(5/2) k) with F = k x1^1.5, a few roundings, and
+        # the C code's Gamma(5/2) (1.3293403881791355) is 1.1e-15 below the
+        # true one: measured 1.3e-15, held to 4e-15
+        assert s.get("semi_integral") == pytest.approx(s.get("x1") ** 1.5 / GAMMA_5_2, rel=4e-15, abs=0)
         assert s.get("E_diss") >= 0.0
-    # The impulse the master would apply is the striker's change of momentum.
-    assert total_impulse == pytest.approx(0.6 * (0.5 - s.get("v_striker")), rel=1e-12)
-    assert s.get("eps") == pytest.approx(-s.get("v_striker") / 0.5, rel=1e-14)
+    # The impulse the master would apply is the striker's change of momentum:
+    # a sum of ~130 steps' F_avg H, rounding bound n eps = 3e-14 (measured
+    # 1.6e-15).
+    assert total_impulse == pytest.approx(0.6 * (0.5 - s.get("v_striker")), rel=3e-14, abs=0)
+    # eps = -v_end / v_onset, and v_onset = v = 0.5 (no gravity): one division
+    assert s.get("eps") == pytest.approx(-s.get("v_striker") / 0.5, rel=EPS, abs=0)
