@@ -73,9 +73,13 @@ class BadInput(Exception):
     """An input this tool cannot use; the message says what is wrong and where."""
 
 
+# t_c v0 / x_max of an elastic Hertz impact: 2 integral_0^1 (1 - u^(5/2))^(-1/2) du = (4/5) B(2/5, 1/2).
+HERTZ_CONTACT_TIME = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
+
+
 def hertz_time(k, m, v0):
     """The Hertz contact time of k, m, v0: the scale of every step here."""
-    return 2.94327 * (5 * m * v0 ** 2 / (4 * k)) ** 0.4 / v0
+    return HERTZ_CONTACT_TIME * (5 * m * v0 ** 2 / (4 * k)) ** 0.4 / v0
 
 
 def simulate(k, c, m, v0, law="hertz", csv_path=None, interval=None):

@@ -456,9 +456,12 @@ static void print_table(const options *o, const figures *f, double k)
 
 /* ------------------------------------------------------------ the solves */
 
-/* The elastic Hertz contact time over x_ref / v (MODEL.md §2: 2.943...), to
- * the precision a row spacing needs. */
-#define ELASTIC_CONTACT_TIME 2.94
+/* The elastic Hertz contact time over x_ref / v (MODEL.md §2):
+ * 2 integral_0^1 (1 - u^(5/2))^(-1/2) du = (4/5) B(2/5, 1/2). */
+static double elastic_contact_time(void)
+{
+    return 0.8 * tgamma(0.4) * tgamma(0.5) / tgamma(0.9);
+}
 
 static double default_output_interval(const options *o)
 {
@@ -468,7 +471,7 @@ static double default_output_interval(const options *o)
         return o->t_end / 1000.0;
     contact_start(&cm, &o->p, o->v0, o->m);
     contact_scales(&o->p, contact_spring_stiffness(&cm, 0), o->v0, o->m, &x_ref, &t_ref);
-    return t_ref > 0.0 ? ELASTIC_CONTACT_TIME * t_ref / 256.0 : o->t_end / 1000.0;
+    return t_ref > 0.0 ? elastic_contact_time() * t_ref / 256.0 : o->t_end / 1000.0;
 }
 
 /* Rows at the output times k * interval in (before->s.t, t], each the model
