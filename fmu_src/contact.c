@@ -143,7 +143,7 @@ int contact_unused_material(const contact_params *p, char *msg, size_t len)
     return 1;
 }
 
-int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
+int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len)
 {
     if (!isfinite(v))
         return reject(msg, len, "v", v, "the striker velocity must be finite [m/s]");
@@ -153,6 +153,15 @@ int contact_check_striker(int scene, double v, double m, char *msg, size_t len)
         return reject(msg, len, "m", m,
                       "the striker mass must be positive, finite and not denormal, or 0 in the driven scene (no "
                       "striker inertia) [kg]");
+    /* What a run must be able to hold in doubles: the striker's kinetic
+     * energy, the power its weight can dissipate in the dashpot, and the
+     * power of a dashpot driven at the rate v. */
+    if (m > 0.0 && !isfinite(0.5 * m * v * v))
+        return reject(msg, len, "v", v, "the striker's kinetic energy m v^2 / 2 exceeds double precision");
+    if (m > 0.0 && !isfinite(m * p->g * (m * p->g) / p->c))
+        return reject(msg, len, "g", p->g, "the power (m g)^2 / c its weight can dissipate exceeds double precision");
+    if (m == 0.0 && !isfinite(p->c * v * v))
+        return reject(msg, len, "v", v, "the power c v^2 of the dashpot driven at v exceeds double precision");
     return 0;
 }
 

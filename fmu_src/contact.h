@@ -91,8 +91,10 @@ int contact_check_params(const contact_params *p, char *msg, size_t len);
  * Returns 1 and the message naming the first such parameter, or 0. */
 int contact_unused_material(const contact_params *p, char *msg, size_t len);
 
-/* The same for the striker inputs: velocity v [m/s] and mass m [kg]. */
-int contact_check_striker(int scene, double v, double m, char *msg, size_t len);
+/* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
+ * `scene` with the parameters *p (which must have passed their check): a
+ * run must also be able to hold its energies and powers in doubles. */
+int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len);
 
 /* Takes the parameters and the constants derived from them (k, 1/c, a fixed
  * stiffness), leaving the state alone: for a state restored from elsewhere. */

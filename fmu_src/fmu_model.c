@@ -74,7 +74,7 @@ static void preview_start(fmu_model *fm)
     if (fm->started)
         return;
     if (contact_check_params(&fm->params, why, sizeof why) == 0
-        && contact_check_striker(CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0)
+        && contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0)
         /* The mass only scales the dynamics, which a preview does not run. */
         contact_start(&fm->model, &fm->params, fm->v, fm->m > 0.0 ? fm->m : 1.0);
 }
@@ -121,7 +121,7 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
         return set_parameter(fm, var, &value, sizeof value);
     /* Inputs: the scene-dependent rule (m > 0 in the drop test) waits for
      * fm_start, since the scene may still change. */
-    if (contact_check_striker(CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
+    if (contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
                               vr == VR_m ? value : fm->m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     *(double *)((char *)fm + var->offset) = value;
@@ -255,7 +255,7 @@ fm_status fm_start(fmu_model *fm, double t0)
 {
     char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
-        || contact_check_striker(fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
+        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_start(&fm->model, &fm->params, fm->v, fm->m);
     fm->model.s.t = t0;
@@ -358,7 +358,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
     char why[256];
     fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
-        || contact_check_striker(CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
+        || contact_check_striker(&trial.params, CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
     if (!contact_state_is_finite(&trial.model.s) || !isfinite(trial.F_avg) || !isfinite(trial.v_slope)
         || !isfinite(trial.model.inv_m)

@@ -65,8 +65,8 @@ TABLE = {
     "v": {"0": ("at rest", "the striker rests on the specimen: nothing moves"),
           "negative": ("receding", "the striker moves away: free flight, no contact"),
           "denormal": ("tiny impact", "a valid speed: an impact too slow to indent measurably in 2 ms"),
-          "huge": (REFUSED_INIT, "the impact energy m v^2/2 = 3.7e599 J is beyond double precision: no run "
-                                 "can have finite outputs (a rule on m and v: the drop test)")},
+          "huge": (REFUSED_SET, "the impact energy m v^2/2 = 3.7e599 J is beyond double precision, and so is "
+                                "c v^2 without inertia: no run can have finite outputs, whatever m becomes")},
     "m": {"0": (REFUSED_INIT, "the drop test needs a mass (0 is the driven scene's 'no inertia')"),
           "negative": (REFUSED_SET, "a mass is >= 0"),
           "denormal": (REFUSED_SET, "1/m would overflow (README)"),

@@ -6,6 +6,7 @@
 
 #include <inttypes.h>
 #include <math.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -253,7 +254,7 @@ static int check_model(const options *o)
     char why[300];
     size_t k, n;
     if (contact_check_params(&o->p, why, sizeof why) == 0
-        && contact_check_striker(o->p.scene, o->v0, o->m, why, sizeof why) == 0)
+        && contact_check_striker(&o->p, o->p.scene, o->v0, o->m, why, sizeof why) == 0)
         return 0;
     n = strcspn(why, " ");
     for (k = 0; k < N_OPTIONS; k++)
@@ -364,15 +365,43 @@ static void keep_state(series *s, const contact_model *cm)
          cm->s.E_diss);
 }
 
+static int write_csv_rows(const char *tmp, const char *path, const series *s);
+
+/* The temporary file being written, removed if a signal ends the run. */
+static char csv_tmp[4096];
+
+static void remove_csv_tmp(int sig)
+{
+    unlink(csv_tmp); /* async-signal-safe, as are the two calls below */
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void on_signals(void (*handler)(int))
+{
+    static const int signals[] = {SIGINT, SIGTERM, SIGHUP};
+    size_t i;
+    for (i = 0; i < sizeof signals / sizeof signals[0]; i++)
+        signal(signals[i], handler);
+}
+
 /* Written to FILE.tmp and renamed, so that an interrupted run never leaves a
- * complete-looking file. */
+ * complete-looking file, nor (when a signal interrupts it) the temporary one. */
 static int write_csv(const char *path, const series *s)
 {
-    char tmp[4096];
+    int ok;
+    snprintf(csv_tmp, sizeof csv_tmp, "%s.tmp", path);
+    on_signals(remove_csv_tmp);
+    ok = write_csv_rows(csv_tmp, path, s);
+    on_signals(SIG_DFL);
+    return ok;
+}
+
+static int write_csv_rows(const char *tmp, const char *path, const series *s)
+{
     FILE *f;
     size_t i;
     int ok;
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
     f = fopen(tmp, "w");
     if (!f) {
         fprintf(stderr, PROGRAM ": --csv '%s': cannot write: ", path);
@@ -466,11 +495,11 @@ static double elastic_contact_time(void)
 static double default_output_interval(const options *o)
 {
     contact_model cm;
-    double x_ref, t_ref;
+    double x_ref, t_ref, x_small;
     if (o->p.scene == CONTACT_SCENE_DRIVEN && !(o->m > 0.0)) /* one contact, as long as the run */
         return o->t_end / 1000.0;
     contact_start(&cm, &o->p, o->v0, o->m);
-    contact_scales(&o->p, contact_spring_stiffness(&cm, 0), o->v0, o->m, &x_ref, &t_ref);
+    contact_scales(&o->p, contact_spring_stiffness(&cm, 0), o->v0, o->m, &x_ref, &t_ref, &x_small);
     return t_ref > 0.0 ? elastic_contact_time() * t_ref / 256.0 : o->t_end / 1000.0;
 }
 

@@ -157,7 +157,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     ode o;
     integrator in;
     gsl_odeiv2_system sys;
-    double scale[4], x_ref, t_ref, bracket, y[4], y1[4], t = 0.0;
+    double scale[4], x_ref, t_ref, x_small, bracket, y[4], y1[4], t = 0.0;
     double v_onset = v0, t_onset = 0.0, E_diss_onset = 0.0, F_peak_contact = 0.0;
     long k = 1;
     int in_contact, out_of_memory = 0;
@@ -171,15 +171,17 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     o.evaluations = 0;
     memset(r, 0, sizeof *r);
 
-    /* Tolerance scales: the Hertz indentation of the impact, or the
-     * indentation at which the dashpot takes over a driven rate. */
-    contact_scales(p, o.K, v0, m, &x_ref, &t_ref);
-    if (!(x_ref > 0.0) || !isfinite(x_ref))
-        x_ref = p->gap0 > 0.0 ? p->gap0 : 1e-6;
-    scale[0] = scale[2] = 1e-3 * x_ref;
-    scale[1] = 1e-3 * (fabs(v0) > 0.0 ? fabs(v0) : sqrt(fabs(p->g) * x_ref) + 1e-9);
-    scale[3] = 1e-3 * o.K * pow(x_ref, 2.5);
-    r->stiff = is_stiff(&o, t_ref > 0.0 ? x_ref / t_ref : fabs(v0), x_ref);
+    /* Tolerance scales: the indentation where the contact first changes
+     * character (elastic peak or dashpot take-over), its speed and energy;
+     * never below 1e-280, so that the absolute tolerances stay above the
+     * denormals when the striker barely moves (v0 = 5e-324). */
+    contact_scales(p, o.K, v0, m, &x_ref, &t_ref, &x_small);
+    if (!(x_small > 0.0) || !isfinite(x_small))
+        x_small = p->gap0 > 0.0 ? p->gap0 : 1e-6;
+    scale[0] = scale[2] = fmax(1e-3 * x_small, 1e-280);
+    scale[1] = fmax(1e-3 * (fabs(v0) > 0.0 ? fabs(v0) : sqrt(fabs(p->g) * x_small) + 1e-9), 1e-280);
+    scale[3] = fmax(1e-3 * o.K * pow(x_small, 2.5), 1e-280);
+    r->stiff = is_stiff(&o, t_ref > 0.0 ? x_ref / t_ref : fabs(v0), t_ref > 0.0 ? x_ref : x_small);
     bracket = t_ref > 0.0 ? t_ref / 64.0 : 1e-6;
 
     sys.function = rhs;
@@ -229,7 +231,9 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
                 integrate(&in, t, y, tp, yp);
                 F_peak_contact = fmax(F_peak_contact, force(&o, yp[0]));
             }
-            if (y1[0] <= 0.0) {                      /* separation inside (t, t1] */
+            /* separation inside (t, t1]: x1 falls to 0 on the way out (an
+             * indentation that underflows on the way in is none) */
+            if (y1[0] <= 0.0 && !(event_value(&o, 1, y1) > 0.0)) {
                 impact_figures done;
                 t1 = event_time(&in, t, y, t1, 0);
                 integrate(&in, t, y, t1, y1);

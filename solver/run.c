@@ -29,13 +29,16 @@ const char *run_stop_name(int stop)
     return stop == RUN_STOP_IMPACTS ? "impacts" : stop == RUN_STOP_T_END ? "t_end" : "receding";
 }
 
-void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref)
+void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref,
+                    double *x_small)
 {
     double g = p->scene == CONTACT_SCENE_DROP || m > 0.0 ? p->g : 0.0;
-    double v2 = v0 * v0 + 2.0 * g * p->gap0, v = v2 > 0.0 ? sqrt(v2) : 0.0;
-    *x_ref = *t_ref = 0.0;
+    double v2 = v0 * v0 + 2.0 * g * p->gap0, v = v2 > 0.0 ? sqrt(v2) : 0.0, x_dashpot;
+    *x_ref = *t_ref = *x_small = 0.0;
     if (!(v > 0.0 && (v0 > 0.0 || g > 0.0)))
         return;
-    *x_ref = m > 0.0 ? pow(1.25 * m * v * v / K, 0.4) : pow(v * p->c / K, 2.0 / 3.0);
+    x_dashpot = pow(v * p->c / K, 2.0 / 3.0);
+    *x_ref = m > 0.0 ? pow(1.25 * m * v * v / K, 0.4) : x_dashpot;
     *t_ref = *x_ref / v;
+    *x_small = fmin(*x_ref, x_dashpot);
 }

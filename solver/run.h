@@ -36,13 +36,15 @@ enum run_stop {
 };
 const char *run_stop_name(int stop); /* "impacts", "t_end", "receding" */
 
-/* The scales of a contact with spring stiffness K: the indentation x_ref
- * [m] (the elastic Hertz maximum x_max = (5 m v^2 / (4 K))^(2/5) for a
- * striker of mass m arriving at speed v, or where the dashpot takes over a
- * driven rate v without inertia, (v c / K)^(2/3)), and the time t_ref = x_ref
- * / v [s] it takes to get there. v is the impact speed: v0, or where the
- * striker falls through the gap gap0 under g, sqrt(v0^2 + 2 g gap0). Both 0
- * when nothing moves towards the specimen. */
-void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref);
+/* The scales of a contact with spring stiffness K, for a striker of mass m
+ * arriving at speed v (v0, or where it falls through the gap gap0 under g,
+ * sqrt(v0^2 + 2 g gap0)): the elastic Hertz maximum x_max = (5 m v^2 /
+ * (4 K))^(2/5), and the indentation (v c / K)^(2/3) at which the dashpot
+ * takes over the rate v. *x_ref is the first (the second without inertia,
+ * m = 0), *t_ref = x_ref / v the time to get there, and *x_small the smaller
+ * of the two: where the contact first changes character, the scale for an
+ * absolute tolerance. All 0 when nothing moves towards the specimen. */
+void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref,
+                    double *x_small);
 
 #endif

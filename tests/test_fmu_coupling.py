@@ -13,13 +13,12 @@ import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
 
+from closed_forms import EPS, GAMMA_5_2
 from fmu_driver import K, M
 
 VR = {"v": 1, "m": 2, "F": 13, "F_avg": 14, "F_peak": 15, "x": 16, "x1": 17, "x2": 18, "v_striker": 19,
       "E_diss": 20, "eps": 21, "semi_integral": 22}
-GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
 RIGID = 1e20  # a dashpot that does not move: x1 = x
-EPS = 2.0 ** -52
 
 
 def test_the_velocity_follows_the_slope_inside_a_step(slave):

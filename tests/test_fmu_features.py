@@ -15,28 +15,18 @@ import os
 import pathlib
 import re
 import subprocess
-from fractions import Fraction
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy_contact import solve_drop
 
+from closed_forms import EPS, GAMMA_5_2, HERTZ_TC, SCHEME_RTOL, extrapolated_ratio, hertz_k
 from fmu_driver import C, K, M, V0
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOLVE = os.environ.get("FRACCONTACT_SOLVE", str(ROOT / "build" / "fraccontact-solve"))
 
-EPS = 2.0 ** -52
-GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
-# t_c = (4/5) B(2/5, 1/2) x_max / v0 (MODEL.md §2; the integral is checked
-# by quadrature in test_fmu_physics.py)
-HERTZ_TC = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
-# The scheme's error at dt_max = 1e-7 against a converged solve, 3x the
-# largest measured (see test_fmu_physics.py: F_peak 9.2e-10, eps 3.4e-9,
-# t_contact 2.3e-9, x2 1.3e-9, E_diss 7.9e-9; with g = 9.81 and a 2 mm gap
-# the same to two digits).
-SCHEME_RTOL = dict(F_peak=3e-9, eps=1e-8, t_contact=7e-9, x2=4e-9, E_diss=2.5e-8)
 # x1 = v t summed over <= 400 internal steps: <= n ulp (measured 1.5e-14),
 # 1.5 times that and a few ulp in F = K x1^1.5 (measured 2.2e-14).
 DRIVEN_RTOL = 1e-13
@@ -51,37 +41,6 @@ def reference(*options):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
-
-
-_RATIONAL = [None, Fraction(1)]
-
-
-def g1_line_ratio(N):
-    """Gamma(N + 3/2) / (Gamma(N) N^(3/2)) (MODEL.md §4) to a few ulp:
-    Gamma(N + 3/2) / (Gamma(5/2) Gamma(N)) = prod_{j=1}^{N-1} (j + 3/2)/j
-    exactly in rationals, then Gamma(5/2) / N^(3/2) (test_fmu_physics.py
-    checks it against math.lgamma)."""
-    while len(_RATIONAL) <= N:
-        n = len(_RATIONAL)
-        _RATIONAL.append(_RATIONAL[-1] * Fraction(2 * n + 1, 2 * (n - 1)))
-    return float(_RATIONAL[N]) * GAMMA_5_2 / (N * math.sqrt(N))
-
-
-def extrapolated_ratio(N):
-    """Richardson's extrapolation of the G1 ratio r(N) = 1 + a1/N + a2/N^2 +
-    ... from N and M = floor(N/2) intervals: N r(N) - M r(M) = (N - M) +
-    a2 (1/N - 1/M) + ..., so (N r(N) - M r(M)) / (N - M) drops the 1/N term
-    for odd N as for even (where it is 2 r(N) - r(N/2)). N = 1 has no
-    coarser grid: r(1)."""
-    M_ = N // 2
-    if M_ < 1:
-        return g1_line_ratio(N)
-    return (N * g1_line_ratio(N) - M_ * g1_line_ratio(M_)) / (N - M_)
-
-
-def hertz_k(R, E_i, nu_i, E_s, nu_s):
-    """MODEL.md §2: k = (4/3) E* sqrt(R), 1/E* = (1 - nu_i^2)/E_i + (1 - nu_s^2)/E_s."""
-    return 4.0 / 3.0 * math.sqrt(R) / ((1 - nu_i ** 2) / E_i + (1 - nu_s ** 2) / E_s)
 
 
 def onsets_logged(s):

@@ -7,51 +7,14 @@ tolerance, 1e-12, is larger than the quantities themselves when they are in
 metres) and a relative tolerance derived from the method's error."""
 
 import math
-from fractions import Fraction
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy_contact import solve_drop
 
+from closed_forms import EPS, GAMMA_5_2, HERTZ_TC, SCHEME_RTOL, g1_line_ratio, hertz_k
 from fmu_driver import C, K, M, run_impact
-
-GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
-EPS = 2.0 ** -52  # machine epsilon, the ulp of 1.0 (twice the unit roundoff)
-
-# The elastic Hertz contact time (MODEL.md §2): t_c = 2 (x_max/v0) ∫₀¹ (1 − u^(5/2))^(−1/2) du;
-# with w = u^(5/2) the integral is (2/5) B(2/5, 1/2), so t_c = (4/5) B(2/5, 1/2) x_max/v0
-# (2.9432751843247...; MODEL.md's 2.94327 is that truncated, 1.8e-6 too small).
-HERTZ_TC = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
-
-# What the drop test's results may differ from a converged solve of the same
-# ODE at dt_max = 1e-7 (the default): the scheme is second order, its error
-# ~(dt/t_c)^2 = 5.8e-9 times a constant per quantity. Measured (h20, N = 10
-# fixed, and g = 9.81 with a gap, all alike): F_peak 9.2e-10, eps 3.4e-9,
-# t_contact 2.3e-9, x2 1.3e-9, E_diss 7.9e-9; the tolerances are 3x those.
-SCHEME_RTOL = dict(F_peak=3e-9, eps=1e-8, t_contact=7e-9, x2=4e-9, E_diss=2.5e-8)
-
-_RATIONAL = [None, Fraction(1)]
-
-
-def g1_line_ratio(N):
-    """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), MODEL.md §4, to a few ulp.
-
-    Gamma(N + 3/2) / (Gamma(5/2) Gamma(N)) = prod_{j=1}^{N-1} (j + 3/2) / j
-    is rational: Python's Fraction keeps it exact and float() rounds it once;
-    the rest (Gamma(5/2) = 3 sqrt(pi)/4, N^(3/2)) costs four more roundings.
-    (exp(lgamma(N + 3/2) - lgamma(N) - 1.5 ln N) errs by an ulp of
-    ln Gamma(N) ~ N ln N: 3e-13 at N = 400, which would hide errors below it;
-    test_rational_ratio_agrees_with_lgamma checks the two agree to that.)"""
-    while len(_RATIONAL) <= N:
-        n = len(_RATIONAL)  # Gamma(n + 3/2)/Gamma(n) = Gamma(n + 1/2)/Gamma(n - 1) * (n + 1/2)/(n - 1)
-        _RATIONAL.append(_RATIONAL[-1] * Fraction(2 * n + 1, 2 * (n - 1)))
-    return float(_RATIONAL[N]) * GAMMA_5_2 / (N * math.sqrt(N))
-
-
-def hertz_k(R, E_i, nu_i, E_s, nu_s):
-    return 4.0 / 3.0 * math.sqrt(R) / ((1 - nu_i ** 2) / E_i + (1 - nu_s ** 2) / E_s)
-
 
 def reference_drop(k, c, m, v0, method="DOP853", rtol=1e-13):
     """The drop test's ODE by scipy (scripts/scipy_contact.py), independent
