@@ -498,12 +498,12 @@ def check_rigid_spring(j, case, r, solve):
 def check_elastic_hertz(j, case, r, solve):
     """c = 1e300: the elastic Hertz impact (MODEL.md §2):
     x_max = (5 m v0^2 / (4 k))^(2/5), F_peak = k x_max^(3/2), eps = 1,
-    t_c = 2.94327 x_max / v0; the separation time read from the free flight
+    t_c = (4/5) B(2/5, 1/2) x_max / v0; the separation time read from the free flight
     that follows (x - x2 = v (t - t_sep))."""
     p = params(case)
     m, k, v0 = p["m"], p["k"], p["v"]
     x_max = (5 * m * v0 ** 2 / (4 * k)) ** 0.4
-    t_c = 2.94327 * x_max / v0
+    t_c = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9) * x_max / v0
     h = internal_step(case)
     tol = scheme_tolerance(t_c / (2 * h), h, t_c)
     j.basis = f"Hertz closed forms, rel {tol:.2g}"
