@@ -37,6 +37,12 @@ void contact_default_params(contact_params *p)
     p->scheme = CONTACT_SCHEME_SDIRK2;
 }
 
+void contact_default_striker(double *v, double *m)
+{
+    *v = 0.626418; /* sqrt(2 g h) for the paper's 20 mm drop */
+    *m = 0.7437;
+}
+
 double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s)
 {
     double E_star = 1.0 / ((1.0 - nu_i * nu_i) / E_i + (1.0 - nu_s * nu_s) / E_s);
@@ -54,7 +60,7 @@ static const char *shown(double value, char text[32])
     return text;
 }
 
-static int reject(char *msg, size_t len, const char *name, double value, const char *rule)
+int contact_reject(char *msg, size_t len, const char *name, double value, const char *rule)
 {
     char text[32];
     snprintf(msg, len, "%s = %s is invalid: %s", name, shown(value, text), rule);
@@ -70,42 +76,42 @@ static int poisson_ratio(double x) { return isfinite(x) && x > -1.0 && x <= 0.5;
 int contact_check_params(const contact_params *p, char *msg, size_t len)
 {
     if (!positive(p->R))
-        return reject(msg, len, "R", p->R, "the tip radius must be positive and finite [m]");
+        return contact_reject(msg, len, "R", p->R, "the tip radius must be positive and finite [m]");
     if (!positive(p->E_i))
-        return reject(msg, len, "E_i", p->E_i, "Young's modulus must be positive and finite [Pa]");
+        return contact_reject(msg, len, "E_i", p->E_i, "Young's modulus must be positive and finite [Pa]");
     if (!poisson_ratio(p->nu_i))
-        return reject(msg, len, "nu_i", p->nu_i, "a Poisson ratio must lie in (-1, 0.5]");
+        return contact_reject(msg, len, "nu_i", p->nu_i, "a Poisson ratio must lie in (-1, 0.5]");
     if (!positive(p->E_s))
-        return reject(msg, len, "E_s", p->E_s, "Young's modulus must be positive and finite [Pa]");
+        return contact_reject(msg, len, "E_s", p->E_s, "Young's modulus must be positive and finite [Pa]");
     if (!poisson_ratio(p->nu_s))
-        return reject(msg, len, "nu_s", p->nu_s, "a Poisson ratio must lie in (-1, 0.5]");
+        return contact_reject(msg, len, "nu_s", p->nu_s, "a Poisson ratio must lie in (-1, 0.5]");
     if (!(p->k == 0.0 || invertible(p->k)))
-        return reject(msg, len, "k", p->k,
+        return contact_reject(msg, len, "k", p->k,
                       "the Hertz constant must be positive, finite and not denormal, or 0 to derive it from R, "
                       "E_i, nu_i, E_s, nu_s [N/m^1.5]");
     if (p->k == 0.0 && !invertible(hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s)))
-        return reject(msg, len, "k", p->k,
+        return contact_reject(msg, len, "k", p->k,
                       "the Hertz constant derived from R, E_i, nu_i, E_s, nu_s is out of range (zero, denormal or "
                       "infinite)");
     if (!invertible(p->c))
-        return reject(msg, len, "c", p->c, "the dashpot constant must be positive, finite and not denormal [N s/m]");
+        return contact_reject(msg, len, "c", p->c, "the dashpot constant must be positive, finite and not denormal [N s/m]");
     if (!invertible(p->dt_max))
-        return reject(msg, len, "dt_max", p->dt_max,
+        return contact_reject(msg, len, "dt_max", p->dt_max,
                       "the largest internal step must be positive, finite and not denormal [s]");
     if (!isfinite(p->g))
-        return reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
+        return contact_reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
     if (!nonnegative(p->gap0))
-        return reject(msg, len, "gap0", p->gap0, "the initial gap must be finite and >= 0 [m]");
+        return contact_reject(msg, len, "gap0", p->gap0, "the initial gap must be finite and >= 0 [m]");
     if (p->law < CONTACT_LAW_G1 || p->law > CONTACT_LAW_G1_EXTRAPOLATED)
-        return reject(msg, len, "law", p->law,
+        return contact_reject(msg, len, "law", p->law,
                       "1 = G1 history sum, 2 = closed-form Hertz, 3 = G1 with Richardson extrapolation");
     if (p->g1_nodes < 0)
-        return reject(msg, len, "g1_nodes", p->g1_nodes,
+        return contact_reject(msg, len, "g1_nodes", p->g1_nodes,
                       "the number of G1 intervals must be >= 0 (0 = internal steps since contact onset)");
     if (p->scene != CONTACT_SCENE_DROP && p->scene != CONTACT_SCENE_DRIVEN)
-        return reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
+        return contact_reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
     if (p->scheme != CONTACT_SCHEME_SDIRK2 && p->scheme != CONTACT_SCHEME_CENTRAL)
-        return reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
+        return contact_reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
     return 0;
 }
 
@@ -146,22 +152,22 @@ int contact_unused_material(const contact_params *p, char *msg, size_t len)
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len)
 {
     if (!isfinite(v))
-        return reject(msg, len, "v", v, "the striker velocity must be finite [m/s]");
+        return contact_reject(msg, len, "v", v, "the striker velocity must be finite [m/s]");
     if (scene == CONTACT_SCENE_DROP && !invertible(m))
-        return reject(msg, len, "m", m, "the drop test's striker mass must be positive, finite and not denormal [kg]");
+        return contact_reject(msg, len, "m", m, "the drop test's striker mass must be positive, finite and not denormal [kg]");
     if (!(m == 0.0 || invertible(m)))
-        return reject(msg, len, "m", m,
+        return contact_reject(msg, len, "m", m,
                       "the striker mass must be positive, finite and not denormal, or 0 in the driven scene (no "
                       "striker inertia) [kg]");
     /* What a run must be able to hold in doubles: the striker's kinetic
      * energy, the power its weight can dissipate in the dashpot, and the
      * power of a dashpot driven at the rate v. */
     if (m > 0.0 && !isfinite(0.5 * m * v * v))
-        return reject(msg, len, "v", v, "the striker's kinetic energy m v^2 / 2 exceeds double precision");
+        return contact_reject(msg, len, "v", v, "the striker's kinetic energy m v^2 / 2 exceeds double precision");
     if (m > 0.0 && !isfinite(m * p->g * (m * p->g) / p->c))
-        return reject(msg, len, "g", p->g, "the power (m g)^2 / c its weight can dissipate exceeds double precision");
+        return contact_reject(msg, len, "g", p->g, "the power (m g)^2 / c its weight can dissipate exceeds double precision");
     if (m == 0.0 && !isfinite(p->c * v * v))
-        return reject(msg, len, "v", v, "the power c v^2 of the dashpot driven at v exceeds double precision");
+        return contact_reject(msg, len, "v", v, "the power c v^2 of the dashpot driven at v exceeds double precision");
     return 0;
 }
 

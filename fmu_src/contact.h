@@ -76,8 +76,10 @@ typedef struct {
     contact_state s;
 } contact_model;
 
-/* The paper's h20 test (MODEL.md §6, DESIGN.md). */
+/* The paper's h20 test (MODEL.md §6, DESIGN.md): the parameters, and the
+ * striker's impact velocity v [m/s] and mass m [kg]. */
 void contact_default_params(contact_params *p);
+void contact_default_striker(double *v, double *m);
 
 /* k = (4/3) E* sqrt(R), 1/E* = (1 - nu_i^2)/E_i + (1 - nu_s^2)/E_s. */
 double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s);
@@ -85,6 +87,10 @@ double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s
 /* 0 when every parameter is usable; otherwise -1 and a message naming the
  * first offending parameter and its value. */
 int contact_check_params(const contact_params *p, char *msg, size_t len);
+
+/* Writes "name = value is invalid: rule" (the value as a user would type it)
+ * and returns -1: every check's message. */
+int contact_reject(char *msg, size_t len, const char *name, double value, const char *rule);
 
 /* A warning when k != 0 is given while a material parameter (R, E_i, nu_i,
  * E_s, nu_s) differs from its default: k wins, and that value has no effect.

@@ -106,8 +106,7 @@ void fm_reset(fmu_model *fm)
     memset(fm, 0, sizeof *fm);
     fm->log = log;
     contact_default_params(&fm->params);
-    fm->v = 0.626418; /* sqrt(2 g h) for the paper's 20 mm drop */
-    fm->m = 0.7437;
+    contact_default_striker(&fm->v, &fm->m);
     preview_start(fm);
 }
 

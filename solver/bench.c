@@ -26,10 +26,11 @@ static double ns_per_step(int law)
     for (r = 0; r < 15; r++) {
         contact_params p;
         contact_model cm;
-        double t0;
+        double t0, v0, m;
         contact_default_params(&p);
         p.law = law;
-        contact_start(&cm, &p, 0.626418, 0.7437);
+        contact_default_striker(&v0, &m);
+        contact_start(&cm, &p, v0, m);
         t0 = cpu_seconds();
         while (cm.s.impacts == 0)
             contact_advance(&cm, 100 * p.dt_max);

@@ -13,7 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "contact.h"
+#include "fraccontact.h"
 #include "reference.h"
 #include "run.h"
 #include "timing.h"
@@ -23,9 +23,9 @@
 #define G_EARTH 9.81
 
 typedef struct {
-    contact_params p;
-    double v0, m, height, t_end, output_interval, rtol;
-    int impacts, repeat;
+    fc_params p;
+    double height, output_interval, rtol;
+    int repeat;
     const char *csv;
     int json, reference, quiet;
     const char *typed[N_OPTIONS_MAX]; /* each option's value as typed (NULL: not given) */
@@ -55,21 +55,10 @@ static const char *finite_nonnegative(const void *value)
     return isfinite(x) && x >= 0.0 ? NULL : "must be finite and >= 0";
 }
 
-static const char *finite_positive(const void *value)
-{
-    double x = *(const double *)value;
-    return isfinite(x) && x > 0.0 ? NULL : "must be positive and finite";
-}
-
 static const char *between_0_and_1(const void *value)
 {
     double x = *(const double *)value;
     return x > 0.0 && x < 1.0 ? NULL : "must lie in (0, 1)";
-}
-
-static const char *at_least_one(const void *value)
-{
-    return *(const int *)value >= 1 ? NULL : "must be >= 1";
 }
 
 static const char *repeat_count(const void *value)
@@ -81,8 +70,8 @@ static const char *repeat_count(const void *value)
 static const option table[] = {
     {"--height", REAL, AT(height), "drop height h [m]: v0 = sqrt(2 * 9.81 * h) (overrides --v0)", NULL,
      finite_nonnegative},
-    {"--v0", REAL, AT(v0), "impact velocity towards the specimen [m/s] (default 0.626418, the paper's 20 mm); driven scene: the constant indentation rate", "v", NULL},
-    {"--m", REAL, AT(m), "striker mass [kg] (default 0.7437); driven scene: 0 = no inertia", "m", NULL},
+    {"--v0", REAL, AT(p.v), "impact velocity towards the specimen [m/s] (default 0.626418, the paper's 20 mm); driven scene: the constant indentation rate", "v", NULL},
+    {"--m", REAL, AT(p.m), "striker mass [kg] (default 0.7437); driven scene: 0 = no inertia", "m", NULL},
     {"--k", REAL, AT(p.k), "Hertz constant [N/m^1.5] (default 3.299e8); 0 derives it from --R, --E-i, --nu-i, --E-s, --nu-s; a k other than 0 wins over them (a warning says so when one of them is set)", "k", NULL},
     {"--c", REAL, AT(p.c), "dashpot constant [N s/m] (default 6080)", "c", NULL},
     {"--R", REAL, AT(p.R), "striker tip radius [m] (default 6.35e-3; used only with --k 0)", "R", NULL},
@@ -97,9 +86,10 @@ static const option table[] = {
     {"--scene", SCENE, AT(p.scene), "drop (default: a free striker) or driven (constant indentation rate --v0)", "scene", NULL},
     {"--g", REAL, AT(p.g), "acceleration of the striker towards the specimen [m/s^2] (default 0; 9.81 for gravity)", "g", NULL},
     {"--gap0", REAL, AT(p.gap0), "gap between striker and specimen at t = 0 [m] (default 0)", "gap0", NULL},
-    {"--t-end", REAL, AT(t_end), "stop at this time if the solve has not stopped before [s] (default 1)", NULL,
-     finite_positive},
-    {"--impacts", INTEGER, AT(impacts), "stop right after this many impacts have ended (default 1)", NULL, at_least_one},
+    {"--t-end", REAL, AT(p.t_end), "stop at this time if the solve has not stopped before [s] (default 1)", "t_end",
+     NULL},
+    {"--impacts", INTEGER, AT(p.impacts), "stop right after this many impacts have ended (default 1)", "impacts",
+     NULL},
     {"--output-interval", REAL, AT(output_interval), "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row after every internal step (large). Default: 1/256 of the elastic Hertz contact time at the impact speed (about 250 rows per contact; 4.8 us at the h20 defaults), or --t-end / 1000 in the driven scene without mass", NULL, finite_nonnegative},
     {"--csv", TEXT, AT(csv), "write the time series to FILE: t, F, x, x1, x2, v, E_diss (SI units)", NULL, NULL},
     {"--json", FLAG, AT(json), "print one JSON object instead of the table", NULL, NULL},
@@ -251,10 +241,9 @@ static int set_option(options *o, const option *opt, const char *value)
  * option and the value as typed. */
 static int check_model(const options *o)
 {
-    char why[300];
+    char why[FC_MESSAGE_SIZE];
     size_t k, n;
-    if (contact_check_params(&o->p, why, sizeof why) == 0
-        && contact_check_striker(&o->p, o->p.scene, o->v0, o->m, why, sizeof why) == 0)
+    if (fc_params_check(&o->p, why, sizeof why) == FC_OK)
         return 0;
     n = strcspn(why, " ");
     for (k = 0; k < N_OPTIONS; k++)
@@ -279,7 +268,7 @@ static int parse(int argc, char **argv, options *o)
 {
     int i;
     size_t k;
-    char warning[512];
+    char warning[FC_MESSAGE_SIZE];
     for (i = 1; i < argc; i++) {
         char name[64];
         const char *value = NULL, *eq = strchr(argv[i], '=');
@@ -313,22 +302,19 @@ static int parse(int argc, char **argv, options *o)
         o->typed[opt - table] = value;
     }
     if (typed_value(o, "--height"))
-        o->v0 = sqrt(2.0 * G_EARTH * o->height);
+        o->p.v = sqrt(2.0 * G_EARTH * o->height);
     if (check_model(o) != 0)
         return 2;
-    if (contact_unused_material(&o->p, warning, sizeof warning))
+    if (fc_params_warning(&o->p, warning, sizeof warning))
         fprintf(stderr, PROGRAM ": warning: %s\n", warning);
     return 0;
 }
 
 /* ------------------------------------------------------------ results */
 
+/* The reference's rows, in the library's layout. */
 typedef struct {
-    double t, F, x, x1, x2, v, E_diss;
-} row;
-
-typedef struct {
-    row *rows;
+    double *rows;
     size_t n, cap;
     int failed;
 } series;
@@ -337,11 +323,12 @@ typedef struct {
 static void keep(void *ctx, double t, double F, double x, double x1, double x2, double v, double E_diss)
 {
     series *s = ctx;
-    if (s->failed || (s->n > 0 && !(t > s->rows[s->n - 1].t)))
+    double *r;
+    if (s->failed || (s->n > 0 && !(t > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
         return;
     if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 4096;
-        row *grown = realloc(s->rows, cap * sizeof *grown);
+        size_t cap = s->cap ? 2 * s->cap : 1024;
+        double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
         if (!grown) {
             s->failed = 1;
             return;
@@ -349,23 +336,17 @@ static void keep(void *ctx, double t, double F, double x, double x1, double x2, 
         s->rows = grown;
         s->cap = cap;
     }
-    s->rows[s->n].t = t;
-    s->rows[s->n].F = F;
-    s->rows[s->n].x = x;
-    s->rows[s->n].x1 = x1;
-    s->rows[s->n].x2 = x2;
-    s->rows[s->n].v = v;
-    s->rows[s->n].E_diss = E_diss;
-    s->n++;
+    r = s->rows + s->n++ * FC_COLUMNS;
+    r[FC_T] = t;
+    r[FC_F] = F;
+    r[FC_X] = x;
+    r[FC_X1] = x1;
+    r[FC_X2] = x2;
+    r[FC_V] = v;
+    r[FC_E_DISS] = E_diss;
 }
 
-static void keep_state(series *s, const contact_model *cm)
-{
-    keep(s, cm->s.t, cm->s.F, contact_total_indentation(cm), contact_elastic_indentation(cm), cm->s.x2, cm->s.v,
-         cm->s.E_diss);
-}
-
-static int write_csv_rows(const char *tmp, const char *path, const series *s);
+static int write_csv_rows(const char *tmp, const char *path, const double *rows, size_t n);
 
 /* The temporary file being written, removed if a signal ends the run. */
 static char csv_tmp[4096];
@@ -387,17 +368,17 @@ static void on_signals(void (*handler)(int))
 
 /* Written to FILE.tmp and renamed, so that an interrupted run never leaves a
  * complete-looking file, nor (when a signal interrupts it) the temporary one. */
-static int write_csv(const char *path, const series *s)
+static int write_csv(const char *path, const double *rows, size_t n)
 {
     int ok;
     snprintf(csv_tmp, sizeof csv_tmp, "%s.tmp", path);
     on_signals(remove_csv_tmp);
-    ok = write_csv_rows(csv_tmp, path, s);
+    ok = write_csv_rows(csv_tmp, path, rows, n);
     on_signals(SIG_DFL);
     return ok;
 }
 
-static int write_csv_rows(const char *tmp, const char *path, const series *s)
+static int write_csv_rows(const char *tmp, const char *path, const double *rows, size_t n)
 {
     FILE *f;
     size_t i;
@@ -409,10 +390,10 @@ static int write_csv_rows(const char *tmp, const char *path, const series *s)
         return -1;
     }
     fprintf(f, "t_s,F_N,x_m,x1_m,x2_m,v_m_per_s,E_diss_J\n");
-    for (i = 0; i < s->n; i++) {
-        const row *r = &s->rows[i];
-        fprintf(f, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", r->t, r->F, r->x, r->x1, r->x2,
-                r->v, r->E_diss);
+    for (i = 0; i < n; i++) {
+        const double *r = rows + i * FC_COLUMNS;
+        fprintf(f, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", r[FC_T], r[FC_F], r[FC_X], r[FC_X1], r[FC_X2],
+                r[FC_V], r[FC_E_DISS]);
     }
     ok = !ferror(f);
     ok = (fclose(f) == 0) && ok;
@@ -425,28 +406,27 @@ static int write_csv_rows(const char *tmp, const char *path, const series *s)
     return 0;
 }
 
-typedef struct {
-    double F_peak, eps, t_contact, x_perm, E_diss, v_end, x_end, x1_end, cpu_seconds, t_end;
-    int64_t steps, impacts;
-    int stop;                /* enum run_stop */
-    impact_list per_impact;
-} figures;
+static const char *stop_name(int stop)
+{
+    return stop == FC_STOP_IMPACTS ? "impacts" : stop == FC_STOP_T_END ? "t_end" : "receding";
+}
 
-static void print_json(const options *o, const figures *f, double k)
+static void print_json(const options *o, const fc_result *r, double cpu_seconds)
 {
     static const char *const laws[] = {"", "g1", "hertz", "g1x"};
     static const char *const schemes[] = {"", "sdirk2", "central"};
+    const fc_outcome *f = &r->outcome;
     size_t i;
     printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
            "\"E_diss\": %.17g, \"v_end\": %.17g, \"x_end\": %.17g, \"x1_end\": %.17g, "
            "\"steps\": %" PRId64 ", \"cpu_seconds\": %.9g, \"impacts\": %" PRId64 ", \"separated\": %s, "
            "\"stopped\": \"%s\", \"t_end\": %.17g, \"law\": \"%s\", \"method\": \"%s\", \"dt\": %.17g, "
            "\"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g, \"per_impact\": [",
-           f->F_peak, f->eps, f->t_contact, f->x_perm, f->E_diss, f->v_end, f->x_end, f->x1_end, f->steps,
-           f->cpu_seconds, f->impacts, f->impacts > 0 ? "true" : "false", run_stop_name(f->stop), f->t_end,
-           laws[o->p.law], o->reference ? "reference" : schemes[o->p.scheme], o->p.dt_max, k, o->p.c, o->m, o->v0);
-    for (i = 0; i < f->per_impact.n; i++) {
-        const impact_figures *p = &f->per_impact.list[i];
+           f->F_peak, f->eps, f->t_contact, f->x2, f->E_diss, f->v, f->x, f->x1, f->steps, cpu_seconds,
+           f->impacts, f->impacts > 0 ? "true" : "false", stop_name(f->stop), f->t, laws[o->p.law],
+           o->reference ? "reference" : schemes[o->p.scheme], o->p.dt_max, f->k, o->p.c, o->p.m, o->p.v);
+    for (i = 0; i < r->n_impacts; i++) {
+        const fc_impact *p = &r->per_impact[i];
         printf("%s{\"t_onset\": %.17g, \"v_onset\": %.17g, \"F_peak\": %.17g, \"eps\": %.17g, "
                "\"t_contact\": %.17g, \"x2_end\": %.17g, \"E_diss\": %.17g}",
                i ? ", " : "", p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
@@ -454,19 +434,20 @@ static void print_json(const options *o, const figures *f, double k)
     printf("]}\n");
 }
 
-static void print_table(const options *o, const figures *f, double k)
+static void print_table(const options *o, const fc_result *r, double cpu_seconds)
 {
     static const char *const laws[] = {"", "g1", "hertz", "g1x"};
     static const char *const schemes[] = {"", "sdirk2", "central"};
     static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
                                         "the striker moves away and nothing brings it back"};
+    const fc_outcome *f = &r->outcome;
     size_t i;
     printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v0 = %.6g m/s\n",
-           o->reference ? "reference" : schemes[o->p.scheme], laws[o->p.law], k, o->p.c, o->m, o->v0);
-    if (f->per_impact.n > 0) {
+           o->reference ? "reference" : schemes[o->p.scheme], laws[o->p.law], f->k, o->p.c, o->p.m, o->p.v);
+    if (r->n_impacts > 0) {
         printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");
-        for (i = 0; i < f->per_impact.n; i++) {
-            const impact_figures *p = &f->per_impact.list[i];
+        for (i = 0; i < r->n_impacts; i++) {
+            const fc_impact *p = &r->per_impact[i];
             printf("  %6lu  %11.6g  %13.6g  %10.6g  %9.6g  %13.6g  %10.6g  %10.6g\n", (unsigned long)(i + 1),
                    p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
         }
@@ -474,201 +455,110 @@ static void print_table(const options *o, const figures *f, double k)
     printf("  F_peak     %.10g N (largest of the solve)\n", f->F_peak);
     printf("  eps        %.10g (last finished impact)\n", f->eps);
     printf("  t_contact  %.10g s (last finished impact)\n", f->t_contact);
-    printf("  x_perm     %.10g m (where the solve stopped)\n", f->x_perm);
+    printf("  x_perm     %.10g m (where the solve stopped)\n", f->x2);
     printf("  E_diss     %.10g J (all impacts)\n", f->E_diss);
-    printf("  v_end      %.10g m/s\n", f->v_end);
+    printf("  v_end      %.10g m/s\n", f->v);
     printf("  impacts    %" PRId64 "\n", f->impacts);
-    printf("  stopped    at t = %.6g s: %s\n", f->t_end, stops[f->stop]);
+    printf("  stopped    at t = %.6g s: %s\n", f->t, stops[f->stop]);
     printf("  steps      %" PRId64 "\n", f->steps);
-    printf("  cpu        %.6g s\n", f->cpu_seconds);
+    printf("  cpu        %.6g s\n", cpu_seconds);
 }
 
 /* ------------------------------------------------------------ the solves */
 
-/* The elastic Hertz contact time over x_ref / v (MODEL.md §2):
- * 2 integral_0^1 (1 - u^(5/2))^(-1/2) du = (4/5) B(2/5, 1/2). */
-static double elastic_contact_time(void)
+typedef struct {
+    double t_end, shown;
+    int impacts;
+} progress_line;
+
+static void show_progress(void *ctx, double t, int64_t steps, int64_t impacts)
 {
-    return 0.8 * tgamma(0.4) * tgamma(0.5) / tgamma(0.9);
+    progress_line *line = ctx;
+    if (cpu_seconds() - line->shown < 0.5)
+        return;
+    line->shown = cpu_seconds();
+    fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " steps, %" PRId64 " of %d impacts   ", t,
+            line->t_end, steps, impacts, line->impacts);
 }
 
-static double default_output_interval(const options *o)
+static int solve_model(const options *o, double interval, fc_result *r)
 {
-    contact_model cm;
-    double x_ref, t_ref, x_small;
-    if (o->p.scene == CONTACT_SCENE_DRIVEN && !(o->m > 0.0)) /* one contact, as long as the run */
-        return o->t_end / 1000.0;
-    contact_start(&cm, &o->p, o->v0, o->m);
-    contact_scales(&o->p, contact_spring_stiffness(&cm, 0), o->v0, o->m, &x_ref, &t_ref, &x_small);
-    return t_ref > 0.0 ? elastic_contact_time() * t_ref / 256.0 : o->t_end / 1000.0;
-}
-
-/* Rows at the output times k * interval in (before->s.t, t], each the model
- * advanced from `before` to that time: what the rows show never changes the
- * steps the solve takes. */
-static void keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
-{
-    for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
-        contact_model at = *before;
-        double tau = (double)*k * interval - before->s.t;
-        if (tau > 0.0 && isnan(contact_advance(&at, tau)))
-            return;
-        keep_state(out, &at);
-    }
-}
-
-static int why_stop(const options *o, const contact_model *cm)
-{
-    if (cm->s.impacts >= o->impacts)
-        return RUN_STOP_IMPACTS;
-    if (cm->s.t >= o->t_end)
-        return RUN_STOP_T_END;
-    return contact_never_returns(cm) ? RUN_STOP_RECEDING : 0;
-}
-
-/* The model as the FMU drives it: in contact one internal step at a time,
- * free flight in one exact step, stopping at every onset and separation, so
- * that no figure depends on the output interval. */
-static int solve_model(const options *o, double interval, series *out, figures *f)
-{
-    contact_model cm;
-    double E_diss_onset = 0.0, t0, shown;
-    int64_t k = 1;
+    char why[FC_MESSAGE_SIZE];
+    progress_line line = {o->p.t_end, 0.0, o->p.impacts};
     int progress = !o->quiet && !o->json && isatty(STDERR_FILENO);
-    contact_start(&cm, &o->p, o->v0, o->m);
-    if (out)
-        keep_state(out, &cm);
-    t0 = shown = cpu_seconds();
-    while (!(f->stop = why_stop(o, &cm))) {
-        const contact_model before = cm;
-        double H = o->t_end - cm.s.t;
-        if (cm.s.in_contact || o->p.scheme == CONTACT_SCHEME_CENTRAL)
-            H = fmin(H, o->p.dt_max);
-        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
-            fprintf(stderr, PROGRAM ": the state became non-finite near t = %.9g s\n", cm.s.t);
-            return -1;
-        }
-        if (cm.s.in_contact && !before.s.in_contact)
-            E_diss_onset = before.s.E_diss;
-        if (cm.s.impacts > before.s.impacts) {
-            impact_figures done = {cm.s.t_onset, cm.s.v_onset, cm.s.F_peak_contact, cm.s.eps,
-                                   cm.s.t_contact, cm.s.x2, cm.s.E_diss - E_diss_onset};
-            if (impact_list_add(&f->per_impact, &done) != 0) {
-                fprintf(stderr, PROGRAM ": out of memory for the per-impact figures\n");
-                return -1;
-            }
-        }
-        if (out) {
-            keep_rows_until(out, &before, cm.s.t, interval, &k);
-            if (interval == 0.0 || cm.s.in_contact != before.s.in_contact)
-                keep_state(out, &cm);
-        }
-        if (progress && (cm.s.steps & 0xffff) == 0 && cpu_seconds() - shown > 0.5) {
-            shown = cpu_seconds();
-            fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " steps, %" PRId64 " of %d impacts   ",
-                    cm.s.t, o->t_end, cm.s.steps, cm.s.impacts, o->impacts);
-        }
-    }
-    if (out)
-        keep_state(out, &cm);
-    if (progress && shown > t0)
-        fprintf(stderr, "\n");
-    f->cpu_seconds = cpu_seconds() - t0;
-    f->F_peak = cm.s.F_peak;
-    f->eps = cm.s.eps;
-    f->t_contact = cm.s.t_contact;
-    f->x_perm = cm.s.x2;
-    f->E_diss = cm.s.E_diss;
-    f->v_end = cm.s.v;
-    f->x_end = contact_total_indentation(&cm);
-    f->x1_end = contact_elastic_indentation(&cm);
-    f->steps = cm.s.steps;
-    f->impacts = cm.s.impacts;
-    f->t_end = cm.s.t;
-    return 0;
-}
-
-static int solve_reference(const options *o, double interval, series *out, figures *f)
-{
-    reference_result r;
-    char why[300];
-    double t0 = cpu_seconds();
-    if (reference_solve(&o->p, o->v0, o->m, o->rtol, o->t_end, o->impacts, interval, out ? keep : NULL, out,
-                        &f->per_impact, &r, why, sizeof why) != 0) {
+    line.shown = cpu_seconds();
+    if (fc_run_with_progress(&o->p, interval, progress ? show_progress : NULL, &line, r, why, sizeof why) != FC_OK) {
         fprintf(stderr, PROGRAM ": %s\n", why);
         return -1;
     }
-    f->cpu_seconds = cpu_seconds() - t0;
-    f->F_peak = r.F_peak;
-    f->eps = r.eps;
-    f->t_contact = r.t_contact;
-    f->x_perm = r.x_perm;
-    f->E_diss = r.E_diss;
-    f->v_end = r.v;
-    f->x_end = r.x;
-    f->x1_end = r.x1;
-    f->steps = r.rhs_evaluations;
-    f->impacts = r.impacts;
-    f->t_end = r.t;
-    f->stop = r.stop;
+    if (progress && r->outcome.steps >= 65536)
+        fprintf(stderr, "\n");
     return 0;
 }
 
-/* One solve, or --repeat of them with the median CPU time; the series is
- * kept from the first only. */
-static int solve(const options *o, double interval, series *out, figures *f)
+static int solve_reference(const options *o, double interval, fc_result *r)
 {
-    double *times = malloc((size_t)o->repeat * sizeof *times);
+    reference_result ref;
+    impact_list impacts = {NULL, 0, 0};
+    series rows = {NULL, 0, 0, 0};
+    char why[FC_MESSAGE_SIZE];
+    int status = reference_solve(&o->p, o->rtol, interval, interval >= 0.0 ? keep : NULL, &rows, &impacts, &ref,
+                                 why, sizeof why);
+    memset(r, 0, sizeof *r);
+    r->per_impact = impacts.list;
+    r->n_impacts = impacts.n;
+    r->rows = rows.rows;
+    r->n_rows = rows.n;
+    if (status != 0 || rows.failed) {
+        fprintf(stderr, PROGRAM ": %s\n", status != 0 ? why : "out of memory for the --csv series");
+        return -1;
+    }
+    r->outcome = ref.outcome;
+    return 0;
+}
+
+/* One solve, or --repeat of them; returns the median CPU time of the solve
+ * alone, or -1. The result is the last solve's. */
+static double solve(const options *o, double interval, fc_result *r)
+{
+    double *times = malloc((size_t)o->repeat * sizeof *times), seconds = -1.0;
     int i, status = times ? 0 : -1;
     for (i = 0; i < o->repeat && status == 0; i++) {
-        f->per_impact.n = 0;
-        status = o->reference ? solve_reference(o, interval, i == 0 ? out : NULL, f)
-                              : solve_model(o, interval, i == 0 ? out : NULL, f);
-        if (times)
-            times[i] = f->cpu_seconds;
+        double t0 = cpu_seconds();
+        if (i > 0)
+            fc_result_free(r);
+        status = o->reference ? solve_reference(o, interval, r) : solve_model(o, interval, r);
+        times[i] = cpu_seconds() - t0;
     }
     if (status == 0)
-        f->cpu_seconds = median(times, o->repeat);
+        seconds = median(times, o->repeat);
     free(times);
-    return status;
+    return seconds;
 }
 
 int main(int argc, char **argv)
 {
     options o;
-    figures f;
-    series s = {NULL, 0, 0, 0};
-    contact_model cm;
-    double interval;
+    fc_result r;
+    double interval, seconds;
     int status;
     memset(&o, 0, sizeof o);
-    memset(&f, 0, sizeof f);
-    contact_default_params(&o.p);
-    o.v0 = 0.626418;
-    o.m = 0.7437;
-    o.t_end = 1.0;
-    o.impacts = 1;
+    fc_params_default(&o.p);
     o.repeat = 1;
     o.rtol = 1e-12;
     status = parse(argc, argv, &o);
     if (status != 0)
         return status < 0 ? 0 : status;
-    interval = typed_value(&o, "--output-interval") ? o.output_interval : default_output_interval(&o);
-    status = solve(&o, interval, o.csv ? &s : NULL, &f);
-    if (status == 0 && s.failed) {
-        fprintf(stderr, PROGRAM ": out of memory for the --csv series\n");
-        status = -1;
-    }
-    if (status == 0 && o.csv && write_csv(o.csv, &s) != 0)
-        status = -1;
-    free(s.rows);
-    if (status == 0) {
-        contact_start(&cm, &o.p, o.v0, o.m);
+    interval = !o.csv ? FC_NO_ROWS : typed_value(&o, "--output-interval") ? o.output_interval
+                                                                            : fc_default_output_interval(&o.p);
+    seconds = solve(&o, interval, &r);
+    status = seconds < 0.0 || (o.csv && write_csv(o.csv, r.rows, r.n_rows) != 0);
+    if (!status) {
         if (o.json)
-            print_json(&o, &f, cm.k);
+            print_json(&o, &r, seconds);
         else
-            print_table(&o, &f, cm.k);
+            print_table(&o, &r, seconds);
     }
-    impact_list_free(&f.per_impact);
-    return status == 0 ? 0 : 1;
+    fc_result_free(&r);
+    return status;
 }

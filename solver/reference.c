@@ -149,10 +149,12 @@ static void sample_state(const ode *o, double t, const double y[4], reference_sa
     sample(ctx, t, force(o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
 }
 
-int reference_solve(const contact_params *p, double v0, double m, double rtol, double t_end,
-                    long impacts, double out_dt, reference_sample sample, void *ctx,
-                    impact_list *per_impact, reference_result *r, char *msg, size_t len)
+int reference_solve(const fc_params *params, double rtol, double out_dt, reference_sample sample, void *ctx,
+                    impact_list *per_impact, reference_result *result, char *msg, size_t len)
 {
+    fc_outcome *r = &result->outcome;
+    contact_params model, *p = &model;
+    const double v0 = params->v, m = params->m, t_end = params->t_end;
     contact_model cm;
     ode o;
     integrator in;
@@ -163,13 +165,15 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     int in_contact, out_of_memory = 0;
     gsl_error_handler_t *previous = gsl_set_error_handler_off();
 
+    fc_model_params(params, &model);
     contact_start(&cm, p, v0, m);
     o.K = contact_spring_stiffness(&cm, 0); /* the continuous law (N fixed, or N -> infinity) */
     o.inv_c = cm.inv_c;
     o.inv_m = cm.inv_m;
     o.accel = cm.accel;
     o.evaluations = 0;
-    memset(r, 0, sizeof *r);
+    memset(result, 0, sizeof *result);
+    r->k = cm.k;
 
     /* Tolerance scales: the indentation where the contact first changes
      * character (elastic peak or dashpot take-over), its speed and energy;
@@ -181,7 +185,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     scale[0] = scale[2] = fmax(1e-3 * x_small, 1e-280);
     scale[1] = fmax(1e-3 * (fabs(v0) > 0.0 ? fabs(v0) : sqrt(fabs(p->g) * x_small) + 1e-9), 1e-280);
     scale[3] = fmax(1e-3 * o.K * pow(x_small, 2.5), 1e-280);
-    r->stiff = is_stiff(&o, t_ref > 0.0 ? x_ref / t_ref : fabs(v0), t_ref > 0.0 ? x_ref : x_small);
+    result->stiff = is_stiff(&o, t_ref > 0.0 ? x_ref / t_ref : fabs(v0), t_ref > 0.0 ? x_ref : x_small);
     bracket = t_ref > 0.0 ? t_ref / 64.0 : 1e-6;
 
     sys.function = rhs;
@@ -190,7 +194,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     sys.params = &o;
     in.o = &o;
     in.status = GSL_SUCCESS;
-    in.driver = gsl_odeiv2_driver_alloc_scaled_new(&sys, r->stiff ? gsl_odeiv2_step_msbdf : gsl_odeiv2_step_rk8pd,
+    in.driver = gsl_odeiv2_driver_alloc_scaled_new(&sys, result->stiff ? gsl_odeiv2_step_msbdf : gsl_odeiv2_step_rk8pd,
                                                    1e-12, rtol, rtol, 1.0, 0.0, scale);
     if (!in.driver) {
         snprintf(msg, len, "reference: GSL could not allocate its driver");
@@ -208,9 +212,9 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     while (in.status == GSL_SUCCESS && !out_of_memory) {
         double t1;
         int event = 0;
-        r->stop = r->impacts >= impacts ? RUN_STOP_IMPACTS
-                  : t >= t_end          ? RUN_STOP_T_END
-                  : !in_contact && never_returns(&cm, y) ? RUN_STOP_RECEDING
+        r->stop = r->impacts >= params->impacts ? FC_STOP_IMPACTS
+                  : t >= t_end          ? FC_STOP_T_END
+                  : !in_contact && never_returns(&cm, y) ? FC_STOP_RECEDING
                                                           : 0;
         if (r->stop)
             break;
@@ -234,7 +238,7 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
             /* separation inside (t, t1]: x1 falls to 0 on the way out (an
              * indentation that underflows on the way in is none) */
             if (y1[0] <= 0.0 && !(event_value(&o, 1, y1) > 0.0)) {
-                impact_figures done;
+                fc_impact done;
                 t1 = event_time(&in, t, y, t1, 0);
                 integrate(&in, t, y, t1, y1);
                 y1[0] = 0.0;
@@ -250,6 +254,8 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
                 done.t_contact = r->t_contact;
                 done.x2_end = y1[2];
                 done.E_diss = y1[3] - E_diss_onset;
+                if (r->impacts == 1)
+                    r->first = done;
                 out_of_memory = impact_list_add(per_impact, &done) != 0;
             }
             F_peak_contact = fmax(F_peak_contact, force(&o, y1[0]));
@@ -269,9 +275,10 @@ int reference_solve(const contact_params *p, double v0, double m, double rtol, d
     r->v = y[1];
     r->x1 = y[0] > 0.0 ? y[0] : 0.0;
     r->x = y[0] + y[2];
-    r->x_perm = y[2];
+    r->x2 = y[2];
     r->E_diss = y[3];
-    r->rhs_evaluations = o.evaluations;
+    r->steps = o.evaluations;
+    r->status = in.status == GSL_SUCCESS && !out_of_memory ? FC_OK : FC_EFAIL;
     gsl_odeiv2_driver_free(in.driver);
     gsl_set_error_handler(previous);
     if (out_of_memory) {

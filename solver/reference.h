@@ -12,13 +12,8 @@
 #include "run.h"
 
 typedef struct {
-    double F_peak, eps, t_contact, x_perm, E_diss;
-    double t;            /* where the solve stopped [s] */
-    double v, x, x1;     /* striker velocity, total and elastic indentation there */
-    long impacts;
-    long rhs_evaluations;
+    fc_outcome outcome;  /* as the library's runs give it; steps: right-hand-side evaluations */
     int stiff;           /* 1: BDF was used */
-    int stop;            /* enum run_stop: why the solve stopped */
 } reference_result;
 
 /* Called at every output time with t, F, x (total indentation), x1 (the
@@ -26,16 +21,15 @@ typedef struct {
 typedef void (*reference_sample)(void *ctx, double t, double F, double x, double x1, double x2, double v,
                                  double E_diss);
 
-/* Solves from t = 0 (striker at gap0, velocity v0, mass m as in
- * contact_start) at relative tolerance rtol until `impacts` impacts have
- * ended, t_end, or the striker recedes for good, appending each finished
+/* Solves the run *p (striker at gap0, velocity v, mass m as in
+ * contact_start) at relative tolerance rtol until p->impacts impacts have
+ * ended, p->t_end, or the striker recedes for good, appending each finished
  * impact to *impacts. Events are located within brackets of 1/64 of the
  * contact's time scale, whatever the output: the samples, every out_dt and at
  * every onset and separation (out_dt = 0: at every bracket), are integrated
  * from the last bracket and change no figure. Returns 0, or -1 with a
  * message when GSL fails or memory runs out. */
-int reference_solve(const contact_params *p, double v0, double m, double rtol, double t_end,
-                    long impacts, double out_dt, reference_sample sample, void *ctx,
+int reference_solve(const fc_params *p, double rtol, double out_dt, reference_sample sample, void *ctx,
                     impact_list *per_impact, reference_result *result, char *msg, size_t len);
 
 #endif

@@ -3,11 +3,11 @@
 #include <math.h>
 #include <stdlib.h>
 
-int impact_list_add(impact_list *l, const impact_figures *f)
+int impact_list_add(impact_list *l, const fc_impact *f)
 {
     if (l->n == l->cap) {
         size_t cap = l->cap ? 2 * l->cap : 16;
-        impact_figures *grown = realloc(l->list, cap * sizeof *grown);
+        fc_impact *grown = realloc(l->list, cap * sizeof *grown);
         if (!grown)
             return -1;
         l->list = grown;
@@ -15,18 +15,6 @@ int impact_list_add(impact_list *l, const impact_figures *f)
     }
     l->list[l->n++] = *f;
     return 0;
-}
-
-void impact_list_free(impact_list *l)
-{
-    free(l->list);
-    l->list = NULL;
-    l->n = l->cap = 0;
-}
-
-const char *run_stop_name(int stop)
-{
-    return stop == RUN_STOP_IMPACTS ? "impacts" : stop == RUN_STOP_T_END ? "t_end" : "receding";
 }
 
 void contact_scales(const contact_params *p, double K, double v0, double m, double *x_ref, double *t_ref,

@@ -1,40 +1,23 @@
-/* What a solve of the contact model produces besides its time series, and
- * the scales it is measured in; shared by the model's solve and the GSL
- * reference (fraccontact-solve). */
+/* What the library's runs and the GSL reference share: the per-impact list
+ * and the scales of a contact. */
 #ifndef FRACCONTACT_RUN_H
 #define FRACCONTACT_RUN_H
 
 #include <stddef.h>
 
 #include "contact.h"
-
-/* The figures of one finished impact. */
-typedef struct {
-    double t_onset;   /* time of contact onset [s] */
-    double v_onset;   /* striker velocity at onset, towards the specimen [m/s] */
-    double F_peak;    /* largest force of this impact [N] */
-    double eps;       /* restitution coefficient -v_end / v_onset */
-    double t_contact; /* duration of the contact [s] */
-    double x2_end;    /* permanent indentation when it ended (all impacts so far) [m] */
-    double E_diss;    /* energy dissipated during this impact [J] */
-} impact_figures;
+#include "fraccontact.h"
 
 typedef struct {
-    impact_figures *list;
+    fc_impact *list;
     size_t n, cap;
 } impact_list;
 
-/* Appends; -1 when memory runs out (the list is unchanged). */
-int impact_list_add(impact_list *l, const impact_figures *f);
-void impact_list_free(impact_list *l);
+/* The model's parameters of a run. */
+void fc_model_params(const fc_params *p, contact_params *q);
 
-/* Why a solve stopped. */
-enum run_stop {
-    RUN_STOP_IMPACTS = 1,  /* the requested number of impacts ended */
-    RUN_STOP_T_END = 2,    /* the time limit came first */
-    RUN_STOP_RECEDING = 3  /* out of contact, and nothing brings the striker back */
-};
-const char *run_stop_name(int stop); /* "impacts", "t_end", "receding" */
+/* Appends; -1 when memory runs out (the list is unchanged). */
+int impact_list_add(impact_list *l, const fc_impact *f);
 
 /* The scales of a contact with spring stiffness K, for a striker of mass m
  * arriving at speed v (v0, or where it falls through the gap gap0 under g,

@@ -165,12 +165,13 @@ static int steps(double target)
 {
     contact_params p;
     contact_model cm;
-    double t0 = wall_now(), rss[11], max_rss = 0.0;
+    double t0 = wall_now(), rss[11], max_rss = 0.0, v0, m;
     int k = 0, i;
     contact_default_params(&p);
     p.g = 9.81;
     p.c = 1e5; /* a stiffer dashpot rebounds more: many impacts before the striker rests */
-    contact_start(&cm, &p, 0.626418, 0.7437);
+    contact_default_striker(&v0, &m);
+    contact_start(&cm, &p, v0, m);
     rss[k++] = resident_mib();
     while ((double)cm.s.steps < target) {
         if (isnan(contact_advance(&cm, 1e-3))) {

@@ -1,0 +1,319 @@
+#include "fraccontact.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "contact.h"
+#include "run.h"
+
+#define AT(name) offsetof(fc_params, name)
+
+static const fc_parameter parameters[] = {
+    {"v", FC_REAL, AT(v), "m/s", "striker velocity towards the specimen; driven scene: the indentation rate"},
+    {"m", FC_REAL, AT(m), "kg", "striker mass; driven scene: 0 = no inertia"},
+    {"R", FC_REAL, AT(R), "m", "striker tip radius (used only with k = 0)"},
+    {"E_i", FC_REAL, AT(E_i), "Pa", "indenter Young's modulus (used only with k = 0)"},
+    {"nu_i", FC_REAL, AT(nu_i), "1", "indenter Poisson ratio (used only with k = 0)"},
+    {"E_s", FC_REAL, AT(E_s), "Pa", "specimen Young's modulus (used only with k = 0)"},
+    {"nu_s", FC_REAL, AT(nu_s), "1", "specimen Poisson ratio (used only with k = 0)"},
+    {"k", FC_REAL, AT(k), "N/m^1.5",
+     "Hertz constant; 0 derives it from R, E_i, nu_i, E_s, nu_s; any other value wins over them"},
+    {"c", FC_REAL, AT(c), "N s/m", "dashpot constant"},
+    {"dt_max", FC_REAL, AT(dt_max), "s", "largest internal step"},
+    {"g", FC_REAL, AT(g), "m/s^2", "acceleration of the striker towards the specimen (9.81 for gravity)"},
+    {"gap0", FC_REAL, AT(gap0), "m", "gap between striker and specimen at t = 0"},
+    {"t_end", FC_REAL, AT(t_end), "s", "stop at this time if the run has not stopped before"},
+    {"law", FC_INTEGER, AT(law), "1", "spring law: 1 G1 history sum, 2 closed-form Hertz, 3 G1 with Richardson extrapolation"},
+    {"g1_nodes", FC_INTEGER, AT(g1_nodes), "1", "G1 intervals N; 0: internal steps since contact onset"},
+    {"scene", FC_INTEGER, AT(scene), "1", "1 drop test (a free striker), 2 driven (the rate v prescribed)"},
+    {"scheme", FC_INTEGER, AT(scheme), "1", "1 SDIRK2 (implicit, L-stable), 2 the paper's explicit central differences"},
+    {"impacts", FC_INTEGER, AT(impacts), "1", "stop right after this many impacts have ended"},
+};
+
+#define N_PARAMETERS (sizeof parameters / sizeof parameters[0])
+
+size_t fc_parameter_count(void) { return N_PARAMETERS; }
+
+const fc_parameter *fc_parameter_at(size_t i) { return i < N_PARAMETERS ? &parameters[i] : NULL; }
+
+size_t fc_params_size(void) { return sizeof(fc_params); }
+
+size_t fc_outcome_size(void) { return sizeof(fc_outcome); }
+
+void fc_model_params(const fc_params *p, contact_params *q)
+{
+    q->R = p->R;
+    q->E_i = p->E_i;
+    q->nu_i = p->nu_i;
+    q->E_s = p->E_s;
+    q->nu_s = p->nu_s;
+    q->k = p->k;
+    q->c = p->c;
+    q->dt_max = p->dt_max;
+    q->g = p->g;
+    q->gap0 = p->gap0;
+    q->law = p->law;
+    q->g1_nodes = p->g1_nodes;
+    q->scene = p->scene;
+    q->scheme = p->scheme;
+}
+
+void fc_params_default(fc_params *p)
+{
+    contact_params q;
+    memset(p, 0, sizeof *p);
+    contact_default_params(&q);
+    contact_default_striker(&p->v, &p->m);
+    p->R = q.R;
+    p->E_i = q.E_i;
+    p->nu_i = q.nu_i;
+    p->E_s = q.E_s;
+    p->nu_s = q.nu_s;
+    p->k = q.k;
+    p->c = q.c;
+    p->dt_max = q.dt_max;
+    p->g = q.g;
+    p->gap0 = q.gap0;
+    p->law = q.law;
+    p->g1_nodes = q.g1_nodes;
+    p->scene = q.scene;
+    p->scheme = q.scheme;
+    p->t_end = 1.0;
+    p->impacts = 1;
+}
+
+fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    if (contact_check_params(&q, msg, len) != 0 || contact_check_striker(&q, q.scene, p->v, p->m, msg, len) != 0)
+        return FC_EINVAL;
+    if (!(p->t_end > 0.0) || !isfinite(p->t_end)) {
+        contact_reject(msg, len, "t_end", p->t_end, "the time limit must be positive and finite [s]");
+        return FC_EINVAL;
+    }
+    if (p->impacts < 1) {
+        contact_reject(msg, len, "impacts", p->impacts, "the number of impacts to stop after must be >= 1");
+        return FC_EINVAL;
+    }
+    return FC_OK;
+}
+
+int fc_params_warning(const fc_params *p, char *msg, size_t len)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    return contact_unused_material(&q, msg, len);
+}
+
+/* t_c v / x_max of an elastic Hertz impact (MODEL.md §2):
+ * 2 integral_0^1 (1 - u^(5/2))^(-1/2) du = (4/5) B(2/5, 1/2). */
+static double elastic_contact_time(void)
+{
+    return 0.8 * tgamma(0.4) * tgamma(0.5) / tgamma(0.9);
+}
+
+double fc_default_output_interval(const fc_params *p)
+{
+    contact_params q;
+    contact_model cm;
+    double x_ref, t_ref, x_small;
+    if (p->scene == CONTACT_SCENE_DRIVEN && !(p->m > 0.0)) /* one contact, as long as the run */
+        return p->t_end / 1000.0;
+    fc_model_params(p, &q);
+    contact_start(&cm, &q, p->v, p->m);
+    contact_scales(&q, contact_spring_stiffness(&cm, 0), p->v, p->m, &x_ref, &t_ref, &x_small);
+    return t_ref > 0.0 ? elastic_contact_time() * t_ref / 256.0 : p->t_end / 1000.0;
+}
+
+/* ------------------------------------------------------------ a run */
+
+typedef struct {
+    double *rows;
+    size_t n, cap;
+    int failed;
+} series;
+
+/* A row, unless it repeats the last one's time (an event on an output time). */
+static void keep(series *s, const contact_model *cm)
+{
+    double *r;
+    if (s->failed || (s->n > 0 && !(cm->s.t > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
+        return;
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 1024;
+        double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
+        if (!grown) {
+            s->failed = 1;
+            return;
+        }
+        s->rows = grown;
+        s->cap = cap;
+    }
+    r = s->rows + s->n++ * FC_COLUMNS;
+    r[FC_T] = cm->s.t;
+    r[FC_F] = cm->s.F;
+    r[FC_X] = contact_total_indentation(cm);
+    r[FC_X1] = contact_elastic_indentation(cm);
+    r[FC_X2] = cm->s.x2;
+    r[FC_V] = cm->s.v;
+    r[FC_E_DISS] = cm->s.E_diss;
+}
+
+/* Rows at the output times k * interval in (before->s.t, t], each the model
+ * advanced from `before` to that time: what the rows show never changes the
+ * steps the run takes. */
+static void keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
+{
+    for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
+        contact_model at = *before;
+        double tau = (double)*k * interval - before->s.t;
+        if (tau > 0.0 && isnan(contact_advance(&at, tau)))
+            return;
+        keep(out, &at);
+    }
+}
+
+static int why_stop(const fc_params *p, const contact_model *cm)
+{
+    if (cm->s.impacts >= p->impacts)
+        return FC_STOP_IMPACTS;
+    if (cm->s.t >= p->t_end)
+        return FC_STOP_T_END;
+    return contact_never_returns(cm) ? FC_STOP_RECEDING : 0;
+}
+
+static void summarize(const contact_model *cm, fc_outcome *o)
+{
+    o->impacts = cm->s.impacts;
+    o->steps = cm->s.steps;
+    o->F_peak = cm->s.F_peak;
+    o->eps = cm->s.eps;
+    o->t_contact = cm->s.t_contact;
+    o->E_diss = cm->s.E_diss;
+    o->t = cm->s.t;
+    o->x = contact_total_indentation(cm);
+    o->x1 = contact_elastic_indentation(cm);
+    o->x2 = cm->s.x2;
+    o->v = cm->s.v;
+    o->k = cm->k;
+}
+
+/* The impact that has just ended, its dissipation counted from its onset. */
+static fc_impact finished_impact(const contact_state *s, double E_diss_onset)
+{
+    fc_impact done;
+    done.t_onset = s->t_onset;
+    done.v_onset = s->v_onset;
+    done.F_peak = s->F_peak_contact;
+    done.eps = s->eps;
+    done.t_contact = s->t_contact;
+    done.x2_end = s->x2;
+    done.E_diss = s->E_diss - E_diss_onset;
+    return done;
+}
+
+/* Ends a run that failed where cm is, with a message already written. */
+static fc_status failed(const contact_model *cm, fc_outcome *o, fc_status status)
+{
+    summarize(cm, o);
+    return o->status = status;
+}
+
+/* The run behind fc_run and fc_run_batch: out may be NULL (no rows), and
+ * impacts NULL (only the first is kept, in r->outcome.first). */
+static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts,
+                     fc_progress progress, void *ctx, fc_outcome *o, char *msg, size_t len)
+{
+    contact_params q;
+    contact_model cm;
+    double E_diss_onset = 0.0;
+    int64_t k = 1, reported = 0;
+    memset(o, 0, sizeof *o);
+    if (fc_params_check(p, msg, len) != FC_OK)
+        return o->status = FC_EINVAL;
+    fc_model_params(p, &q);
+    contact_start(&cm, &q, p->v, p->m);
+    if (out)
+        keep(out, &cm);
+    while (!(o->stop = why_stop(p, &cm))) {
+        const contact_model before = cm;
+        double H = p->t_end - cm.s.t;
+        if (cm.s.in_contact || q.scheme == CONTACT_SCHEME_CENTRAL)
+            H = fmin(H, q.dt_max);
+        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
+            contact_reject(msg, len, "t", cm.s.t, "the state became non-finite in the step from here [s]");
+            return failed(&cm, o, FC_EFAIL);
+        }
+        if (cm.s.in_contact && !before.s.in_contact)
+            E_diss_onset = before.s.E_diss;
+        if (cm.s.impacts > before.s.impacts) {
+            fc_impact done = finished_impact(&cm.s, E_diss_onset);
+            if (cm.s.impacts == 1)
+                o->first = done;
+            if (impacts && impact_list_add(impacts, &done) != 0) {
+                contact_reject(msg, len, "impacts", (double)cm.s.impacts, "out of memory for the per-impact figures");
+                return failed(&cm, o, FC_ENOMEM);
+            }
+        }
+        if (out) {
+            keep_rows_until(out, &before, cm.s.t, interval, &k);
+            if (interval == 0.0 || cm.s.in_contact != before.s.in_contact)
+                keep(out, &cm);
+        }
+        if (progress && cm.s.steps - reported >= 65536) {
+            reported = cm.s.steps;
+            progress(ctx, cm.s.t, cm.s.steps, cm.s.impacts);
+        }
+    }
+    if (out) {
+        keep(out, &cm);
+        if (out->failed) {
+            contact_reject(msg, len, "rows", (double)out->n, "out of memory for the time series");
+            return failed(&cm, o, FC_ENOMEM);
+        }
+    }
+    return failed(&cm, o, FC_OK);
+}
+
+fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress, void *ctx,
+                               fc_result *r, char *msg, size_t len)
+{
+    series rows = {NULL, 0, 0, 0};
+    impact_list impacts = {NULL, 0, 0};
+    fc_status status;
+    double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
+    memset(r, 0, sizeof *r);
+    status = run(p, interval, interval >= 0.0 ? &rows : NULL, &impacts, progress, ctx, &r->outcome, msg, len);
+    r->per_impact = impacts.list;
+    r->n_impacts = impacts.n;
+    r->rows = rows.rows;
+    r->n_rows = rows.n;
+    return status;
+}
+
+fc_status fc_run(const fc_params *p, double output_interval, fc_result *r, char *msg, size_t len)
+{
+    return fc_run_with_progress(p, output_interval, NULL, NULL, r, msg, len);
+}
+
+void fc_result_free(fc_result *r)
+{
+    free(r->per_impact);
+    free(r->rows);
+    memset(r, 0, sizeof *r);
+}
+
+fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out)
+{
+    char why[FC_MESSAGE_SIZE];
+    fc_status first = FC_OK;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        fc_status status = run(&params[i], FC_NO_ROWS, NULL, NULL, NULL, NULL, &out[i], why, sizeof why);
+        if (first == FC_OK)
+            first = status;
+    }
+    return first;
+}

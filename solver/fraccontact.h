@@ -1,0 +1,177 @@
+/* libfraccontact: the contact model of MODEL.md as a C library, for the
+ * solver CLI, the benchmarks and the Python package (GSL's odeiv2 style: a
+ * parameter struct with defaults from one function, status codes, no global
+ * state). The same model code as the FMU; no GSL, libc and libm only.
+ *
+ *   fc_params p;
+ *   fc_result r;
+ *   char why[FC_MESSAGE_SIZE];
+ *   fc_params_default(&p);          the paper's h20 drop test
+ *   p.c = 5000.0;
+ *   if (fc_run(&p, FC_NO_ROWS, &r, why, sizeof why) != FC_OK) ...
+ *   ... r.outcome.first.F_peak, r.per_impact[i].eps ...
+ *   fc_result_free(&r);
+ *
+ * Names, units and defaults of every parameter: fc_parameter_at(). */
+#ifndef FRACCONTACT_H
+#define FRACCONTACT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#define FC_API __declspec(dllexport)
+#else
+#define FC_API __attribute__((visibility("default")))
+#endif
+
+typedef enum {
+    FC_OK = 0,
+    FC_EINVAL = 1, /* a parameter breaks its rule: the message names it, its value and the rule */
+    FC_EFAIL = 2,  /* the state became non-finite (never for valid parameters; a guard) */
+    FC_ENOMEM = 3  /* out of memory for rows or impacts */
+} fc_status;
+
+/* Why a run stopped. */
+typedef enum {
+    FC_STOP_IMPACTS = 1,  /* the requested number of impacts ended */
+    FC_STOP_T_END = 2,    /* the time limit came first */
+    FC_STOP_RECEDING = 3  /* out of contact, and nothing brings the striker back */
+} fc_stop;
+
+#define FC_MESSAGE_SIZE 512
+
+/* The FMU's variables by their names, and the run's stop conditions. */
+typedef struct {
+    double v;        /* striker velocity towards the specimen [m/s]; driven scene: the indentation rate */
+    double m;        /* striker mass [kg]; driven scene: 0 = no inertia */
+    double R;        /* striker tip radius [m] */
+    double E_i;      /* indenter Young's modulus [Pa] */
+    double nu_i;     /* indenter Poisson ratio */
+    double E_s;      /* specimen Young's modulus [Pa] */
+    double nu_s;     /* specimen Poisson ratio */
+    double k;        /* Hertz constant [N/m^1.5]; 0: derive from R, E_i, nu_i, E_s, nu_s */
+    double c;        /* dashpot constant [N s/m] */
+    double dt_max;   /* largest internal step [s] */
+    double g;        /* acceleration of the striker towards the specimen [m/s^2] */
+    double gap0;     /* gap between striker and specimen at t = 0 [m] */
+    double t_end;    /* stop at this time [s] */
+    int law;         /* 1 G1 history sum, 2 closed-form Hertz, 3 G1 with Richardson extrapolation */
+    int g1_nodes;    /* G1 intervals N; 0: internal steps since contact onset */
+    int scene;       /* 1 drop test, 2 driven */
+    int scheme;      /* 1 SDIRK2 (implicit, L-stable), 2 the paper's central differences */
+    int impacts;     /* stop right after this many impacts have ended */
+} fc_params;
+
+/* The paper's h20 drop test (MODEL.md §6): v = sqrt(2 9.81 0.020), m =
+ * 0.7437, k = 3.299e8, c = 6080, dt_max = 1e-7, G1 law; one impact, t_end 1 s. */
+FC_API void fc_params_default(fc_params *p);
+
+/* FC_OK, or FC_EINVAL and a message naming the first parameter that breaks
+ * its rule, with its value and the rule. */
+FC_API fc_status fc_params_check(const fc_params *p, char *msg, size_t len);
+
+/* 1 and a message when a parameter has no effect (a material beside k != 0),
+ * else 0. */
+FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
+
+/* What fc_parameter_at tells of each member of fc_params. */
+typedef enum { FC_REAL = 0, FC_INTEGER = 1 } fc_kind;
+
+typedef struct {
+    const char *name;    /* the member's (and the FMU variable's) name */
+    fc_kind kind;        /* double or int */
+    size_t offset;       /* offsetof(fc_params, name) */
+    const char *unit;    /* SI unit, "1" for a number */
+    const char *help;    /* one line */
+} fc_parameter;
+
+/* The i-th parameter (0 <= i < fc_parameter_count()), in a fixed order;
+ * its default is that member of fc_params_default's. */
+FC_API size_t fc_parameter_count(void);
+FC_API const fc_parameter *fc_parameter_at(size_t i);
+
+/* The figures of one finished impact. */
+typedef struct {
+    double t_onset;   /* time of contact onset [s] */
+    double v_onset;   /* striker velocity at onset [m/s] */
+    double F_peak;    /* largest force of this impact [N] */
+    double eps;       /* restitution coefficient -v_end / v_onset */
+    double t_contact; /* duration of the contact [s] */
+    double x2_end;    /* permanent indentation when it ended (all impacts so far) [m] */
+    double E_diss;    /* energy dissipated during this impact [J] */
+} fc_impact;
+
+/* A run's outcome: its first impact and where it stopped. */
+typedef struct {
+    int status;      /* fc_status of this run */
+    int stop;        /* fc_stop */
+    int64_t impacts; /* finished impacts */
+    int64_t steps;   /* internal steps taken */
+    fc_impact first; /* the first finished impact (zeros when none ended) */
+    double F_peak;   /* the largest force of the run [N] */
+    double eps;      /* of the last finished impact (0 when none) */
+    double t_contact;/* of the last finished impact [s] */
+    double E_diss;   /* energy dissipated in all [J] */
+    double t;        /* where the run stopped [s] */
+    double x, x1, x2;/* total, elastic and permanent indentation there [m] */
+    double v;        /* striker velocity there [m/s] */
+    double k;        /* the Hertz constant used (given, or derived) [N/m^1.5] */
+} fc_outcome;
+
+/* Columns of a row of the time series. */
+enum { FC_T, FC_F, FC_X, FC_X1, FC_X2, FC_V, FC_E_DISS, FC_COLUMNS };
+
+/* A run's results; the library allocates the arrays, fc_result_free frees them. */
+typedef struct {
+    fc_outcome outcome;
+    fc_impact *per_impact; /* every finished impact, in order */
+    size_t n_impacts;
+    double *rows;          /* n_rows * FC_COLUMNS: t, F, x, x1, x2, v, E_diss (SI) */
+    size_t n_rows;
+} fc_result;
+
+/* Output spacing for fc_run: no rows, or a row after every internal step,
+ * or (any positive value) a row every that many seconds; FC_DEFAULT_ROWS
+ * picks fc_default_output_interval(). Rows come also at every onset and
+ * separation, and each is the model advanced to its time from a copy of the
+ * state: no figure depends on the spacing. */
+#define FC_NO_ROWS (-1.0)
+#define FC_EVERY_STEP 0.0
+#define FC_DEFAULT_ROWS (-2.0)
+
+/* 1/256 of the elastic Hertz contact time at the impact speed (about 250
+ * rows per contact), or t_end / 1000 in the driven scene without mass. */
+FC_API double fc_default_output_interval(const fc_params *p);
+
+/* Called now and then during a long run (about every 65536 internal steps)
+ * with the time reached, the steps taken and the impacts finished. */
+typedef void (*fc_progress)(void *ctx, double t, int64_t steps, int64_t impacts);
+
+/* One run from t = 0 until `impacts` impacts have ended, t_end, or the
+ * striker recedes for good: in contact one internal step at a time, free
+ * flight in one exact step, as the FMU does. FC_OK, FC_EINVAL (nothing run),
+ * FC_EFAIL or FC_ENOMEM, with a message; r is filled in every case (free it). */
+FC_API fc_status fc_run(const fc_params *p, double output_interval, fc_result *r, char *msg, size_t len);
+FC_API fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress,
+                                      void *ctx, fc_result *r, char *msg, size_t len);
+FC_API void fc_result_free(fc_result *r);
+
+/* n runs in one call, params[i] -> out[i] (no rows, no per-impact lists):
+ * FC_OK when all ran; else the status of the first that did not (its
+ * out[i].status says which; fc_params_check tells why). */
+FC_API fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out);
+
+/* sizeof(fc_params) and sizeof(fc_outcome): a binding checks its layout. */
+FC_API size_t fc_params_size(void);
+FC_API size_t fc_outcome_size(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
