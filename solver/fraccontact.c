@@ -100,6 +100,11 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
     return FC_OK;
 }
 
+double fc_drop_velocity(double height)
+{
+    return sqrt(2.0 * 9.81 * height);
+}
+
 int fc_params_warning(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;

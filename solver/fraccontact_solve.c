@@ -20,7 +20,6 @@
 
 #define PROGRAM "fraccontact-solve"
 #define N_OPTIONS_MAX 32
-#define G_EARTH 9.81
 
 typedef struct {
     fc_params p;
@@ -302,7 +301,7 @@ static int parse(int argc, char **argv, options *o)
         o->typed[opt - table] = value;
     }
     if (typed_value(o, "--height"))
-        o->p.v = sqrt(2.0 * G_EARTH * o->height);
+        o->p.v = fc_drop_velocity(o->height);
     if (check_model(o) != 0)
         return 2;
     if (fc_params_warning(&o->p, warning, sizeof warning))

@@ -1,0 +1,32 @@
+"""fraccontact: a fractional-calculus contact element for impact simulation.
+
+The model runs in-process on its C library:
+
+    import fraccontact
+    r = fraccontact.impact(height=0.020, c=5000.0)      # r.F_peak, r.eps, r.per_impact
+    a = fraccontact.impacts(c=numpy.linspace(3e3, 9e3, 100))   # arrays, one library call
+    s = fraccontact.simulate(output_interval=1e-5)       # s["t"], s["F"], ...
+    fraccontact.fmu_path()                               # the FMI 2.0 FMU to co-simulate
+"""
+
+import os
+import pathlib
+
+from .model import Impact, Run, impact, impacts, parameters, simulate, warning
+
+__all__ = ["Impact", "Run", "fmu_path", "impact", "impacts", "parameters", "simulate", "warning"]
+
+_HERE = pathlib.Path(__file__).resolve().parent
+_FMU_VARIABLES = {"fraccontact": "FRACCONTACT_FMU", "striker": "STRIKER_FMU"}
+
+
+def fmu_path(name="fraccontact"):
+    """The path of an FMU the package ships: fraccontact (the contact
+    element) or striker (the rigid striker of the co-simulation studies).
+    $FRACCONTACT_FMU / $STRIKER_FMU name another build's."""
+    if name not in _FMU_VARIABLES:
+        raise ValueError(f"no FMU {name!r}: fraccontact or striker")
+    path = pathlib.Path(os.environ.get(_FMU_VARIABLES[name]) or _HERE / f"{name}.fmu")
+    if not path.exists():
+        raise FileNotFoundError(f"{path} does not exist: install the package (pip install .) or build it")
+    return path
