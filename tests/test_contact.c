@@ -10,6 +10,28 @@
 
 static const double V0 = 0.626418, M = 0.7437; /* the paper's h20 drop */
 
+/* The elastic Hertz contact time t_c = HERTZ_TC x_max / v0 (MODEL.md §2):
+ * 2 int_0^1 (1 - u^(5/2))^(-1/2) du, which u^(5/2) = w turns into a beta
+ * function, 2 sqrt(pi) Gamma(7/5) / Gamma(9/10) = 2.9432692... */
+static double hertz_tc_factor(void)
+{
+    return 2.0 * sqrt(acos(-1.0)) * tgamma(1.4) / tgamma(0.9);
+}
+
+static double hertz_contact_time(double k)
+{
+    return hertz_tc_factor() * pow(5.0 * M * V0 * V0 / (4.0 * k), 0.4) / V0;
+}
+
+/* Rounding: a step rounds each of v, x1, x2 and E_diss once or twice by at
+ * most half an ulp of the value, and an energy doubles the velocity's
+ * relative error: 4 ulp per step bounds what rounding alone accumulates,
+ * relative to the figure's scale (scripts/stability.py, ROUNDING_ULPS). */
+static double rounding(int64_t steps)
+{
+    return 4.0 * DBL_EPSILON * (double)(steps + 4);
+}
+
 /* A drop test until the first impact ends or t_end passes, in steps of
  * dt_max (one contact_advance each, as the FMU does). */
 static contact_model drop(int law, double c, double dt, double t_end)
@@ -36,7 +58,9 @@ static void test_hertz_constant(void)
 }
 
 /* Any Runge-Kutta method keeps linear invariants, and m v + c x2 is one:
- * x2_end = m v0 (1 + eps) / c holds to rounding, at any step and any c. */
+ * x2_end = m v0 (1 + eps) / c holds to rounding, at any step and any c.
+ * Measured: at most 2.9e-14 (c = 608, 72 000 steps; the roundings add up
+ * like a random walk, ~sqrt(steps) ulp); allowed 1e-13. */
 static void test_momentum_identity(void)
 {
     static const double cs[] = {608.0, 6080.0, 60800.0, 6.08e6}; /* below ~600 it never rebounds */
@@ -45,12 +69,14 @@ static void test_momentum_identity(void)
         for (i = 0; i < 4; i++) {
             contact_model cm = drop(law, cs[i], 1e-7, 0.05);
             CHECK(cm.s.impacts == 1, "law %d, c %g: no separation", law, cs[i]);
-            CHECK_REL(cm.s.x2, M * V0 * (1.0 + cm.s.eps) / cs[i], 1e-12, "x2_end vs m v0 (1 + eps) / c");
+            CHECK_REL(cm.s.x2, M * V0 * (1.0 + cm.s.eps) / cs[i], 1e-13, "x2_end vs m v0 (1 + eps) / c");
         }
 }
 
 /* Law 2 conserves 1/2 m v^2 + (2/5) k x1^(5/2) + E_diss; the scheme's
- * second-order error is ~ (dt / t_c)^2 ~ 1e-8 at dt = 1e-7, t_c = 1.3 ms. */
+ * second-order error is C (dt / t_c)^2 over the contact, with C = 0.46 to
+ * 0.47 measured at dt = 1e-7 ... 8e-7 (3.1e-9 of the impact energy at
+ * 1e-7, t_c = 1.23 ms); allowed C = 1. */
 static void test_energy_balance(void)
 {
     contact_params p;
@@ -66,7 +92,11 @@ static void test_energy_balance(void)
             worst = fabs(E - E0);
         contact_advance(&cm, 1e-7);
     }
-    CHECK(worst < 1e-7 * E0, "energy balance off by %.3g of the impact energy", worst / E0);
+    {
+        double h = 1e-7 / hertz_contact_time(cm.k);
+        CHECK(worst < 1.0 * h * h * E0, "energy balance off by %.3g of the impact energy, allowed %.3g", worst / E0,
+              h * h);
+    }
 }
 
 /* Self-convergence of the Hertz law at the paper's parameters: errors that
@@ -91,50 +121,108 @@ static void test_second_order(void)
     }
 }
 
-/* The elastic limit (c -> infinity): Hertz impact, MODEL.md §2. */
+/* The elastic limit (c -> infinity): Hertz impact, MODEL.md §2. The
+ * scheme's errors, measured at dt = 1e-7 (h = dt/t_c = 8.1e-5): F_peak
+ * -0.16 h^2 (allowed 0.3 h^2), the contact time +0.50 h^2 (allowed 1.0 h^2,
+ * against the exact constant), eps - 1 = +0.16 h^2.5: the energy SDIRK2
+ * gains in an elastic impact (docs/stability.md: 0.08 to 0.21 h^2.5 from
+ * dt = t_c/12 to t_c/12300), allowed 0.42 h^2.5, twice the largest. */
 static void test_elastic_limit(void)
 {
     contact_model cm = drop(CONTACT_LAW_HERTZ, 1e15, 1e-7, 0.05);
-    double k = cm.k, x_max = pow(5.0 * M * V0 * V0 / (4.0 * k), 0.4);
-    /* Peak sampling and the scheme both err by ~ (dt / t_c)^2 ~ 1e-8. */
-    CHECK_REL(cm.s.F_peak, k * pow(x_max, 1.5), 1e-6, "Hertz F_max");
-    CHECK_REL(cm.s.t_contact, 2.94327 * x_max / V0, 1e-5, "Hertz contact time (closed form given to 6 digits)");
-    CHECK(fabs(cm.s.eps - 1.0) < 1e-6, "eps = %.12f, not 1", cm.s.eps);
+    double k = cm.k, x_max = pow(5.0 * M * V0 * V0 / (4.0 * k), 0.4), t_c = hertz_contact_time(k), h = 1e-7 / t_c;
+    CHECK_REL(cm.s.F_peak, k * pow(x_max, 1.5), 0.3 * h * h, "Hertz F_max");
+    CHECK_REL(cm.s.t_contact, t_c, 1.0 * h * h, "Hertz contact time");
+    CHECK(fabs(cm.s.eps - 1.0) <= 0.42 * pow(h, 2.5), "eps = %.15f, not 1 within %.3g", cm.s.eps, 0.42 * pow(h, 2.5));
+}
+
+/* Known findings (docs/stability.md, scripts/stability.py KNOWN): runs that
+ * fail a check the model satisfies, because of the time scheme. They must
+ * still fail (a fix shows up here: remove the entry); every other run must
+ * pass. ENERGY: SDIRK2 gains energy in nearly elastic Hertz impacts, about
+ * 0.2 (dt/t_c)^2.5 (9 ulp per step at c = 1e9, dt = 1e-7; eps > 1 at
+ * dt = 1e-4). FORCE: its stability function is negative for lambda dt >
+ * 2.41 (lambda the dashpot's relaxation rate), so across a stiff dashpot
+ * the force overshoots c v0, which the model's never exceeds (29 % at c = 1,
+ * dt = 1e-5). */
+enum { FINDING_ENERGY = 1, FINDING_EPS = 2, FINDING_FORCE = 4 };
+
+static int known_findings(int law, double c, double dt)
+{
+    static const struct {
+        int law; /* 0: both */
+        double c, dt;
+        int findings;
+    } known[] = {
+        {2, 1e6, 1e-5, FINDING_ENERGY}, {2, 1e6, 1e-4, FINDING_ENERGY},
+        {2, 1e9, 1e-7, FINDING_ENERGY}, {2, 1e9, 1e-5, FINDING_ENERGY},
+        {2, 1e9, 1e-4, FINDING_ENERGY | FINDING_EPS},
+        {0, 1e-2, 1e-5, FINDING_FORCE}, {0, 1e-2, 1e-4, FINDING_FORCE}, {0, 1e-2, 1e-3, FINDING_FORCE},
+        {0, 1.0, 1e-5, FINDING_FORCE}, {0, 1.0, 1e-4, FINDING_FORCE}, {0, 1.0, 1e-3, FINDING_FORCE},
+        {1, 1e2, 1e-4, FINDING_FORCE}, {0, 1e2, 1e-3, FINDING_FORCE},
+    };
+    size_t i;
+    for (i = 0; i < sizeof known / sizeof known[0]; i++)
+        if ((known[i].law == 0 || known[i].law == law) && known[i].c == c && known[i].dt == dt)
+            return known[i].findings;
+    return 0;
+}
+
+static int known_seen = 0;
+
+/* ok: the check passed; known: it is a known finding, so it must fail. */
+static void check_or_known(int ok, int known, int law, double c, double dt, const char *what, double value)
+{
+    if (known) {
+        CHECK(!ok, "law %d c %g dt %g: known finding '%s' no longer fails (%.3g): remove it from known[]", law, c, dt,
+              what, value);
+        if (!ok) {
+            known_seen++;
+            printf("known finding: law %d, c %g, dt %g: %s (%.3g)\n", law, c, dt, what, value);
+        }
+    } else {
+        CHECK(ok, "law %d c %g dt %g: %s (%.3g)", law, c, dt, what, value);
+    }
 }
 
 /* However stiff the dashpot split and however long the step: finite, no
- * tension, the momentum identity to rounding, and, up to the scheme's
- * second-order error bounded by (dt / t_c)^2 with t_c the Hertz contact time
- * (and the energy's rounding, an ulp a step at worst),
- * eps in [0, 1] and no more energy dissipated and left than came in (nearly
- * elastic cases at dt = t_c / 13 overshoot by 1.4e-4 against the 6e-3
- * allowed). */
+ * tension, the momentum invariant, eps in [0, 1], no energy created (what
+ * is left, kinetic and at least 2/5 k x1^(5/2) elastic, the G1 laws'
+ * stiffness being never below k, plus what was dissipated, never exceeds
+ * the impact energy) and no force above c v0, each to rounding only: no
+ * allowance grows with the step. */
 static void test_stability(void)
 {
     static const double cs[] = {1e-2, 1.0, 1e2, 6080.0, 1e6, 1e9};
     static const double dts[] = {1e-9, 1e-7, 1e-5, 1e-4, 1e-3, 1e-1};
-    const double t_c = 1.3e-3;
     int law, i, j;
     for (law = 1; law <= 2; law++)
         for (i = 0; i < 6; i++)
             for (j = 0; j < 6; j++) {
-                double dt = dts[j], t_end = dt > 1e-4 ? 50 * dt : 2e-3;
+                double c = cs[i], dt = dts[j], t_end = dt > 1e-4 ? 50 * dt : 2e-3, rnd, x1, E0 = 0.5 * M * V0 * V0;
+                double E_left, p_scale;
+                int known = known_findings(law, c, dt);
                 contact_model cm;
-                if (dt < 1e-8 && cs[i] < 1.0)
+                if (dt < 1e-8 && c < 1.0)
                     continue; /* 2 ms at 1 ns is covered by the stiffer cases; keep the test fast */
-                cm = drop(law, cs[i], dt, t_end);
+                cm = drop(law, c, dt, t_end);
+                rnd = rounding(cm.s.steps);
                 CHECK(isfinite(cm.s.x1) && isfinite(cm.s.v) && isfinite(cm.s.x2) && isfinite(cm.s.E_diss),
-                      "law %d c %g dt %g: non-finite state", law, cs[i], dt);
-                CHECK(cm.s.F >= 0.0 && cm.s.F_peak >= 0.0, "law %d c %g dt %g: tension", law, cs[i], dt);
-                CHECK(cm.s.eps >= 0.0 && cm.s.eps <= 1.0 + (dt / t_c) * (dt / t_c),
-                      "law %d c %g dt %g: eps %.17g", law, cs[i], dt, cm.s.eps);
-                CHECK(fabs(M * (V0 - cm.s.v) - cs[i] * cm.s.x2) <= 1e-12 * M * V0,
-                      "law %d c %g dt %g: momentum m (v0 - v) = %.17g vs c x2 = %.17g",
-                      law, cs[i], dt, M * (V0 - cm.s.v), cs[i] * cm.s.x2);
-                CHECK(cm.s.E_diss + 0.5 * M * cm.s.v * cm.s.v
-                          <= 0.5 * M * V0 * V0 * (1.0 + (dt / t_c) * (dt / t_c) + DBL_EPSILON * cm.s.steps),
-                      "law %d c %g dt %g: E_diss %.17g + kinetic energy exceed the impact energy",
-                      law, cs[i], dt, cm.s.E_diss);
+                      "law %d c %g dt %g: non-finite state", law, c, dt);
+                CHECK(cm.s.F >= 0.0 && cm.s.F_peak >= 0.0, "law %d c %g dt %g: tension", law, c, dt);
+                CHECK(cm.s.eps >= 0.0, "law %d c %g dt %g: eps %.17g", law, c, dt, cm.s.eps);
+                check_or_known(cm.s.eps <= 1.0 + rnd, known & FINDING_EPS, law, c, dt, "eps - 1 above rounding",
+                               cm.s.eps - 1.0);
+                p_scale = M * V0 + M * fabs(cm.s.v) + c * fabs(cm.s.x2);
+                CHECK(fabs(M * (V0 - cm.s.v) - c * cm.s.x2) <= rnd * p_scale,
+                      "law %d c %g dt %g: momentum m (v0 - v) = %.17g vs c x2 = %.17g", law, c, dt,
+                      M * (V0 - cm.s.v), c * cm.s.x2);
+                x1 = contact_elastic_indentation(&cm);
+                E_left = 0.5 * M * cm.s.v * cm.s.v + 0.4 * cm.k * x1 * x1 * sqrt(x1) + cm.s.E_diss;
+                check_or_known(E_left - E0 <= rnd * (E_left + E0), known & FINDING_ENERGY, law, c, dt,
+                               "energy created, of the impact energy", (E_left - E0) / E0);
+                check_or_known(cm.s.F_peak <= c * V0 * (1.0 + rnd), known & FINDING_FORCE, law, c, dt,
+                               "F_peak above c v0, relative", cm.s.F_peak / (c * V0) - 1.0);
             }
 }
 
@@ -170,8 +258,10 @@ static void test_gap_and_gravity(void)
     contact_start(&cm, &p, V0, M);
     while (!cm.s.in_contact)
         contact_advance(&cm, 1e-5);
-    CHECK_REL(cm.s.t_onset, (v_on - V0) / g, 1e-12, "onset time");
-    CHECK_REL(cm.s.v_onset, v_on, 1e-12, "onset velocity");
+    /* Rounding only: measured 14 and 11 ulp (with the onset time written
+     * without the cancellation of (v_on - v0) / g); allowed 64 ulp. */
+    CHECK_REL(cm.s.t_onset, 2.0 * gap / (V0 + v_on), 64 * DBL_EPSILON, "onset time");
+    CHECK_REL(cm.s.v_onset, v_on, 64 * DBL_EPSILON, "onset velocity");
     /* It bounces and lands again: repeated impacts under gravity. */
     while (cm.s.impacts < 3 && cm.s.t < 1.0)
         contact_advance(&cm, 1e-5);
@@ -188,5 +278,6 @@ int main(void)
     test_elastic_limit();
     test_stability();
     test_gap_and_gravity();
+    printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }
