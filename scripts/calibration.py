@@ -25,7 +25,7 @@ def heights_sweep(out, k, c, workers=2):
                        "--workers",
                        str(workers), "--out", str(out)]) == 0
     with open(out / "sweep.csv") as f:
-        return [{key: float(v) for key, v in r.items() if key in ("height", "F_peak", "eps", "t_contact", "x_perm")}
+        return [{key: float(v) for key, v in r.items() if key in ("height", "F_peak", "eps", "t_contact", "x2_end")}
                 for r in csv.DictReader(f)]
 
 
@@ -42,7 +42,7 @@ def plot(path, paper_rows, fitted_rows):
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
     spec = [("F_peak", 1, "peak force F_max [N]"), ("eps", 1, "restitution coefficient eps"),
-            ("t_contact", 1e3, "contact time [ms]"), ("x_perm", 1e6, "permanent indentation [um]")]
+            ("t_contact", 1e3, "contact time [ms]"), ("x2_end", 1e6, "permanent indentation [um]")]
     for ax, (key, scale, label) in zip(axes.flat, spec):
         for rows, name in ((paper_rows, "paper's k, c"), (fitted_rows, "k, c fitted to the h20 row")):
             ax.plot([r["height"] * 1e3 for r in rows], [r[key] * scale for r in rows], marker=".", label=name)

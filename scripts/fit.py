@@ -85,8 +85,8 @@ def hertz_time(k, m, v0):
 def simulate(k, c, m, v0, law="hertz", csv_path=None, interval=None):
     """One impact with fraccontact-solve; its JSON (and a CSV if asked)."""
     t_c = hertz_time(k, m, v0)
-    args = [SOLVER, "--json", "--quiet", "--law", law, "--k", k, "--c", c, "--m", m, "--v0", v0,
-            "--dt", t_c / 4000, "--t-end", 1000 * t_c + 1.0]
+    args = [SOLVER, "--json", "--quiet", "--law", law, "--k", k, "--c", c, "--m", m, "--v", v0,
+            "--dt-max", t_c / 4000, "--t-end", 1000 * t_c + 1.0]
     if csv_path:
         args += ["--csv", csv_path, "--output-interval", interval]
     done = subprocess.run([str(a) for a in args], capture_output=True, text=True)

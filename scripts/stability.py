@@ -42,30 +42,30 @@ ROUNDING_ULPS = 4
 # A time scale T is resolved when dt <= T / RESOLVED: then the error
 # expansion C (dt/T)^2 holds (the convergence study starts there).
 RESOLVED = 20
-QUANTITIES = ("F_peak", "eps", "t_contact", "x_perm", "E_diss", "v_end")
+QUANTITIES = ("F_peak", "eps", "t_contact", "x2", "E_diss", "v")
 # Reference comparison, |error| <= C2 (dt/T)^2 [+ D1 dt/T for the G1 law
 # with N = steps since onset] + the reference's own error + rounding, T = t_F
 # for F_peak and E_diss and t_c for the rest (see scales(), time_scale()).
-# Errors: F_peak, t_contact, x_perm and E_diss relative, eps absolute, v_end
+# Errors: F_peak, t_contact, x2 and E_diss relative, eps absolute, v (at the end)
 # over the impact speed.
 # SDIRK2 is second order: C2 is twice the largest error / (dt/T)^2 the
 # convergence study measures over every regime and every dt from T/20 to
-# T/640 (measured maxima: F_peak 0.15, eps 0.31, t_contact 0.49, x_perm
-# 0.60, E_diss 1.8, v_end 0.31; the regimes' constants differ by orders of
+# T/640 (measured maxima: F_peak 0.15, eps 0.31, t_contact 0.49, x2
+# 0.60, E_diss 1.8, v 0.31; the regimes' constants differ by orders of
 # magnitude, so the tolerance is tight for some cases and loose for others,
 # the stiff ones above all: the report lists each run's error over its
 # tolerance).
-C2 = dict(F_peak=0.3, eps=0.62, t_contact=1.0, x_perm=1.2, E_diss=3.6, v_end=0.62)
+C2 = dict(F_peak=0.3, eps=0.62, t_contact=1.0, x2=1.2, E_diss=3.6, v=0.62)
 # The G1 law with N = n steps since onset is Hertz with the stiffness
 # k (1 + 3/(8n) + O(n^-2)) (MODEL.md §4): at time t the relative error is
 # 3 dt / (8 t), a first-order error in dt/T. For the elastic peak force,
 # F_max ~ K^(2/5) with the error 3/(8n) at the peak, n = t_c / (2 dt), gives
 # D ~ 0.4 * 0.75 = 0.30; the study measures 0.27 there. D1 is twice the
-# largest measured (F_peak 0.27, eps 0.58, t_contact 0.41, x_perm 0.92,
-# E_diss 0.84, v_end 0.58), which the G1 errors approach from below as dt
+# largest measured (F_peak 0.27, eps 0.58, t_contact 0.41, x2 0.92,
+# E_diss 0.84, v 0.58), which the G1 errors approach from below as dt
 # falls (eps at h20: 0.32 at dt = t_c/20, 0.42 at t_c/640, 0.425 at
 # t_c/1280).
-D1 = dict(F_peak=0.55, eps=1.2, t_contact=0.82, x_perm=1.9, E_diss=1.7, v_end=1.2)
+D1 = dict(F_peak=0.55, eps=1.2, t_contact=0.82, x2=1.9, E_diss=1.7, v=1.2)
 # The reference at rtol 1e-13; its own error is bounded by its distance to
 # the solve at rtol 1e-12 (the error of either scales with rtol: the distance
 # is ~10 times the error of the rtol 1e-13 solve; 1e-13 to 1e-8 relative,
@@ -95,7 +95,7 @@ FINDINGS = {
            "F_peak exceeds c v0, which the model's force never does. The overshoot is about 1.5 |R(-lambda dt)|, "
            "lambda = 1.5/t_q the dashpot's relaxation rate: 24 % at c = 0.01, steel, v0 = 30 m/s, dt = 1e-8 "
            "(F_peak 0.373 N against the reference's 0.300 N = c v0), 11 % at dt = 1e-7, 1e-6 relative at "
-           "lambda dt = 5e6. L-stable, it stays bounded and decays within a step or two; the impulse, x_perm, "
+           "lambda dt = 5e6. L-stable, it stays bounded and decays within a step or two; the impulse, x2, "
            "v and eps are unaffected (they pass the reference). Resolving the force's rise, dt <= t_F/20, "
            "removes it.",
 }
@@ -201,11 +201,18 @@ def _key(case, law, t_end):
     return (law,) + tuple(sorted(case.items())) + (t_end,)
 
 
+def run_figures(out):
+    """The solver's JSON as the run's figures: the FMU's outputs where it
+    stopped (F_peak the largest, eps and t_contact the last impact's, E_diss
+    in all, x, x1, x2, v, t), its counts and every impact."""
+    return dict(out["end"], **{key: out[key] for key in ("impacts", "stopped", "steps", "k", "per_impact")})
+
+
 @functools.lru_cache(maxsize=None)
 def _solve(solver, key, rtol):
     law, items, t_end = key[0], dict(key[1:-1]), key[-1]
     args = [str(solver), "--json", "--quiet", "--law", law, "--k", "0", "--E-s", items["E_s"], "--c", items["c"],
-            "--v0", items["v0"], "--m", items["m"], "--dt", items["dt"], "--g1-nodes", items["g1_nodes"],
+            "--v", items["v0"], "--m", items["m"], "--dt-max", items["dt"], "--g1-nodes", items["g1_nodes"],
             "--gap0", items["gap0"], "--g", items["g"], "--impacts", items["impacts"], "--t-end", t_end]
     if rtol:
         args += ["--reference", "--rtol", rtol]
@@ -213,7 +220,7 @@ def _solve(solver, key, rtol):
     if done.returncode != 0:
         return None, done.stderr.strip()
     try:
-        return json.loads(done.stdout), ""
+        return run_figures(json.loads(done.stdout)), ""
     except json.JSONDecodeError:
         return None, "not JSON (a non-finite number?): " + done.stdout[:200]
 
@@ -232,8 +239,8 @@ def solve(solver, case, law, t_end, rtol=None):
 
 
 def deviations(r, ref, sc):
-    """The errors of r against ref: F_peak, t_contact, x_perm, E_diss
-    relative, eps absolute, v_end over the velocity scale; eps and t_contact
+    """The errors of r against ref: F_peak, t_contact, x2, E_diss
+    relative, eps absolute, v at the end over the velocity scale; eps and t_contact
     only when both ended the same number of impacts."""
     d = {}
     if ref["F_peak"] > 0:
@@ -241,12 +248,12 @@ def deviations(r, ref, sc):
     if r["impacts"] == ref["impacts"] > 0:
         d["eps"] = abs(r["eps"] - ref["eps"])
         d["t_contact"] = abs(r["t_contact"] / ref["t_contact"] - 1)
-    if ref["x_perm"] != 0:
-        d["x_perm"] = abs(r["x_perm"] / ref["x_perm"] - 1)
+    if ref["x2"] != 0:
+        d["x2"] = abs(r["x2"] / ref["x2"] - 1)
     if ref["E_diss"] > 0:
         d["E_diss"] = abs(r["E_diss"] / ref["E_diss"] - 1)
     if sc["V"] > 0:
-        d["v_end"] = abs(r["v_end"] - ref["v_end"]) / sc["V"]
+        d["v"] = abs(r["v"] - ref["v"]) / sc["V"]
     return d
 
 
@@ -264,7 +271,7 @@ def reference_of(solver, case, law, t_end, sc):
 # peak force and for the dissipation (the integral of F^2/c: a step across
 # a stiff dashpot's force rise misplaces F^2, though not the impulse; at
 # c = 0.01, dt = 1e-7 ~ t_F, E_diss errs by 7.6e-8 = 12 (dt/t_c)^2 where
-# x_perm errs by 6e-9 = 0.9 (dt/t_c)^2), the contact time t_c for the rest
+# x2 errs by 6e-9 = 0.9 (dt/t_c)^2), the contact time t_c for the rest
 # (set by the impulse).
 FAST_FIGURES = ("F_peak", "E_diss")
 
@@ -294,7 +301,7 @@ def invariants(case, r):
     k = r["k"]  # the Hertz constant: the G1 laws' stiffness is never below it
     impacts = r.get("per_impact", [])
     # No tension: the force is K x1^(3/2), x1 >= 0.
-    low = min([r["F_peak"], r["x1_end"]] + [i["F_peak"] for i in impacts])
+    low = min([r["F_peak"], r["x1"]] + [i["F_peak"] for i in impacts])
     out["no tension"] = "" if low >= 0 else f"negative force or indentation {low:.3g}"
     # 0 <= eps <= 1: with g = 0 eps <= 1 is energy conservation (below); under
     # gravity an impact may gain gravity's work m g dx2, so only eps >= 0.
@@ -302,15 +309,15 @@ def invariants(case, r):
     out[EPS] = "" if not bad else f"eps = {bad[0]:.17g}"
     # Momentum: m v + c x2 - m g t is kept exactly by any Runge-Kutta
     # method (a linear invariant) and by exact free flight: to rounding.
-    terms = [m * v0, m * r["v_end"], m * g * r["t_end"], c * r["x_perm"]]
-    residual = m * (v0 - r["v_end"]) + m * g * r["t_end"] - c * r["x_perm"]
+    terms = [m * v0, m * r["v"], m * g * r["t"], c * r["x2"]]
+    residual = m * (v0 - r["v"]) + m * g * r["t"] - c * r["x2"]
     scale = sum(abs(t) for t in terms)
     fig["momentum"] = abs(residual) / scale if scale else abs(residual)
     out["momentum"] = "" if abs(residual) <= rnd * scale else f"momentum off by {fig['momentum']:.2e}"
     # No energy created: kinetic + elastic (at least 2/5 k x1^(5/2)) +
     # dissipated <= kinetic at start + gravity's work, to rounding only.
-    E_kin0, W_g = 0.5 * m * v0 ** 2, m * g * (r["x_end"] + gap0)
-    E_out = 0.5 * m * r["v_end"] ** 2 + 0.4 * k * r["x1_end"] ** 2.5 + r["E_diss"]
+    E_kin0, W_g = 0.5 * m * v0 ** 2, m * g * (r["x"] + gap0)
+    E_out = 0.5 * m * r["v"] ** 2 + 0.4 * k * r["x1"] ** 2.5 + r["E_diss"]
     created, scale = E_out - (E_kin0 + W_g), E_out + E_kin0 + abs(W_g)
     fig["energy"] = created / (E_kin0 + W_g) if E_kin0 + W_g > 0 else created
     why = [] if created <= rnd * scale else [f"run: {created / (E_kin0 + W_g):.3g} of the energy"]
@@ -327,7 +334,7 @@ def invariants(case, r):
     # exceeds c times the largest velocity (v_onset + g t_contact in an
     # impact; v + g t_end over the run).
     g_plus = max(g, 0.0)
-    bounds = [(r["F_peak"], c * (math.sqrt(v0 ** 2 + 2 * g_plus * gap0) + g_plus * r["t_end"]))]
+    bounds = [(r["F_peak"], c * (math.sqrt(v0 ** 2 + 2 * g_plus * gap0) + g_plus * r["t"]))]
     bounds += [(i["F_peak"], c * (i["v_onset"] + g_plus * i["t_contact"])) for i in impacts]
     over = max(F / b - 1 if b > 0 else (math.inf if F > 0 else 0.0) for F, b in bounds)
     fig["force"] = over
@@ -350,7 +357,7 @@ def check(solver, case, law, name=None):
         row["checks"]["finite"] = f"solver failed: {err}"
     else:
         row.update(r)
-        values = [r[k] for k in ("F_peak", "eps", "t_contact", "x_perm", "E_diss", "v_end", "x_end", "x1_end")]
+        values = [r[k] for k in ("F_peak", "eps", "t_contact", "x2", "E_diss", "v", "x", "x1")]
         row["checks"]["finite"] = "" if all(math.isfinite(v) for v in values) else "non-finite output"
     if row["checks"]["finite"]:
         row["failures"] = [f"finite: {row['checks']['finite']}"]
@@ -516,8 +523,8 @@ def write_report(path, study, rows, elapsed):
            f"resolves, dt <= T/{RESOLVED}: T = t_F = min(t_c, t_q) for F_peak, where t_q = (c v/K)^(2/3)/v is "
            "the time in which a stiff dashpot's force is taken over by the spring, also for E_diss (the integral of "
            "F^2/c: a step across the force's rise misplaces F^2, not the impulse), and T = t_c (the Hertz contact "
-           "time) for eps, t_contact, x_perm and v_end. The error (F_peak, t_contact, x_perm, E_diss "
-           "relative; eps absolute; v_end over the impact speed) must stay below "
+           "time) for eps, t_contact, x2 and v (the striker's velocity at the end). The error (F_peak, t_contact, x2, E_diss "
+           "relative; eps absolute; v over the impact speed) must stay below "
            "C2 (dt/T)^2 [+ D1 dt/T for the G1 law with N = steps] + the reference's own error (its distance to "
            f"the rtol {REF_RTOLS[1]:g} solve) + rounding, with", "",
            "| | " + " | ".join(QUANTITIES) + " |", "|---|" + "---|" * len(QUANTITIES),
@@ -574,7 +581,7 @@ def write_report(path, study, rows, elapsed):
             "damping, or the G1 law's falling stiffness); F/cv: F_peak over c v_max, minus 1; vs reference: the "
             "largest error over its tolerance among the resolved figures; deviation: the largest error, "
             "resolved or not.", "",
-            "| case | law | t_c [s] | dt/t_c | dt/t_F | steps | impacts | F_peak [N] | eps | x_perm [m] | energy | "
+            "| case | law | t_c [s] | dt/t_c | dt/t_F | steps | impacts | F_peak [N] | eps | x2 [m] | energy | "
             "momentum | F/cv - 1 | vs reference | deviation | result |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, case, r in rows:
@@ -584,7 +591,7 @@ def write_report(path, study, rows, elapsed):
         dev = f"{r['deviation'][1]:.1e} ({r['deviation'][0]})" if r.get("deviation", ("", 0))[0] else ""
         result = "pass" if not r["failures"] else ("known" if not r["unexpected"] else "FAIL")
         out.append(f"| {name} | {r['law']} | {r['t_c']:.3g} | {r['h']:.2g} | {r['h_F']:.2g} | {f('steps', 'd')} | "
-                   f"{f('impacts', 'd')} | {f('F_peak')} | {f('eps')} | {f('x_perm')} | {f('energy', '.1e')} | "
+                   f"{f('impacts', 'd')} | {f('F_peak')} | {f('eps')} | {f('x2')} | {f('energy', '.1e')} | "
                    f"{f('momentum', '.1e')} | {f('force', '.1e')} | {ratio} | {dev} | {result} |")
     atomic.write_text(path, "\n".join(out) + "\n")
 

@@ -74,7 +74,7 @@ SWEEP_OWNS = {
 TIMING = "cpu_seconds"
 # The plotted results: (key, scale to the unit shown, what it is, unit).
 PLOTTED = (("F_peak", 1, "peak force F_max", "N"), ("eps", 1, "restitution coefficient eps", "1"),
-           ("t_contact", 1e3, "contact time", "ms"), ("x_perm", 1e6, "permanent indentation", "µm"))
+           ("t_contact", 1e3, "contact time", "ms"), ("x2_end", 1e6, "permanent indentation", "µm"))
 # "(default 3.299e8)" in an option's help: the solver's own statement.
 STATED_DEFAULT = re.compile(r"\(default ([-+]?[0-9][0-9.]*(?:[eE][-+]?[0-9]+)?)")
 
@@ -207,13 +207,14 @@ def command(solver, options):
 
 
 def scalar_results(result, case):
-    """What of the solver's JSON fits a CSV cell: numbers and true/false.
-    Strings (law, method), lists and objects are skipped, cpu_seconds too
-    (a timing). A result named like an input of the case gets the suffix
+    """What of the solver's JSON fits a CSV cell: numbers and true/false, and
+    NaN for a figure of the first impact when none ended (null). Strings
+    (stopped, method), lists and objects are skipped, cpu_seconds too (a
+    timing). A result named like an input of the case gets the suffix
     _result: the input is asked (impacts: at most 3), the result is what
     happened (impacts: 1 finished; k: the one derived from E_s when k = 0)."""
-    return {f"{key}_result" if key in case else key: v for key, v in result.items()
-            if isinstance(v, (int, float)) and key != TIMING}
+    return {f"{key}_result" if key in case else key: math.nan if v is None else v for key, v in result.items()
+            if (v is None or isinstance(v, (int, float))) and key != TIMING}
 
 
 def run_batch(solver, fixed, cases):
@@ -268,13 +269,17 @@ def is_number(v):
 def statistics(rows):
     """Mean, sample standard deviation (none of one impact) and the 5, 50 and
     95 % percentiles (numpy's linear interpolation) of every numeric column,
-    over the impacts that succeeded."""
+    over the impacts that succeeded and where the figure exists (an impact
+    that did not end by t_end has no eps)."""
     good = [r for r in rows if "error" not in r]
     out = {}
     for key in dict.fromkeys(k for r in good for k in r):
         column = [r.get(key) for r in good]
         if all(is_number(v) for v in column):
             x = np.array(column, dtype=float)
+            x = x[np.isfinite(x)]
+            if not len(x):
+                continue
             p5, p50, p95 = np.percentile(x, (5, 50, 95))
             out[key] = dict(mean=float(x.mean()), std=float(x.std(ddof=1)) if len(x) > 1 else None,
                             p5=float(p5), p50=float(p50), p95=float(p95))
@@ -327,7 +332,7 @@ def histograms(path, rows, stats, title):
     bins = int(np.clip(round(math.sqrt(len(good))), 5, 50))
     fig, axes = plt.subplots(1, 4, figsize=(17, 4.4))
     for ax, (key, scale, what, unit) in zip(axes, PLOTTED):
-        ax.hist([r[key] * scale for r in good], bins=bins, color="tab:blue", alpha=0.7)
+        ax.hist([r[key] * scale for r in good if math.isfinite(r[key])], bins=bins, color="tab:blue", alpha=0.7)
         s = {k: v * scale for k, v in stats[key].items() if v is not None}
         u = "" if unit == "1" else f" {unit}"
         spread = f" ± {s['std']:.3g}{u} (std)" if "std" in s else u

@@ -19,7 +19,7 @@
 #include "timing.h"
 
 #define PROGRAM "fraccontact-solve"
-#define N_OPTIONS_MAX 32
+#define N_OPTIONS_MAX 40
 
 typedef struct {
     fc_params p;
@@ -38,15 +38,18 @@ typedef enum { REAL, INTEGER, LAW, SCHEME, SCENE, TEXT, FLAG } option_kind;
 typedef const char *(*option_rule)(const void *value);
 
 typedef struct {
-    const char *name;
+    char name[32];
     option_kind kind;
-    size_t offset;
-    const char *help;
-    const char *variable; /* the model's name for it, as in its messages */
-    option_rule rule;     /* for the solver's own options (the model checks its own) */
+    size_t offset;        /* of its field in options */
+    char help[512];
+    const char *variable; /* the library's name for it, as in its messages */
+    option_rule rule;     /* for the solver's own options (the library checks its own) */
 } option;
 
-#define AT(field) offsetof(options, field)
+typedef struct {
+    option list[N_OPTIONS_MAX];
+    size_t n;
+} option_table;
 
 static const char *finite_nonnegative(const void *value)
 {
@@ -66,75 +69,109 @@ static const char *repeat_count(const void *value)
     return n >= 1 && n <= 100000 ? NULL : "must lie in 1..100000";
 }
 
-static const option table[] = {
-    {"--height", REAL, AT(height), "drop height h [m]: v0 = sqrt(2 * 9.81 * h) (overrides --v0)", NULL,
-     finite_nonnegative},
-    {"--v0", REAL, AT(p.v), "impact velocity towards the specimen [m/s] (default 0.626418, the paper's 20 mm); driven scene: the constant indentation rate", "v", NULL},
-    {"--m", REAL, AT(p.m), "striker mass [kg] (default 0.7437); driven scene: 0 = no inertia", "m", NULL},
-    {"--k", REAL, AT(p.k), "Hertz constant [N/m^1.5] (default 3.299e8); 0 derives it from --R, --E-i, --nu-i, --E-s, --nu-s; a k other than 0 wins over them (a warning says so when one of them is set)", "k", NULL},
-    {"--c", REAL, AT(p.c), "dashpot constant [N s/m] (default 6080)", "c", NULL},
-    {"--R", REAL, AT(p.R), "striker tip radius [m] (default 6.35e-3; used only with --k 0)", "R", NULL},
-    {"--E-i", REAL, AT(p.E_i), "indenter Young's modulus [Pa] (default 210e9; used only with --k 0)", "E_i", NULL},
-    {"--nu-i", REAL, AT(p.nu_i), "indenter Poisson ratio (default 0.3; used only with --k 0)", "nu_i", NULL},
-    {"--E-s", REAL, AT(p.E_s), "specimen Young's modulus [Pa] (default 2.64e9; used only with --k 0)", "E_s", NULL},
-    {"--nu-s", REAL, AT(p.nu_s), "specimen Poisson ratio (default 0.4; used only with --k 0)", "nu_s", NULL},
-    {"--law", LAW, AT(p.law), "spring law: g1 (G1 history sum, default), hertz (closed form), g1x (G1 with Richardson extrapolation)", "law", NULL},
-    {"--g1-nodes", INTEGER, AT(p.g1_nodes), "G1 intervals N (default 0: internal steps since contact onset)", "g1_nodes", NULL},
-    {"--dt", REAL, AT(p.dt_max), "internal time step [s] (default 1e-7)", "dt_max", NULL},
-    {"--scheme", SCHEME, AT(p.scheme), "time scheme: sdirk2 (implicit, L-stable, second order; default) or central (the paper's explicit central differences)", "scheme", NULL},
-    {"--scene", SCENE, AT(p.scene), "drop (default: a free striker) or driven (constant indentation rate --v0)", "scene", NULL},
-    {"--g", REAL, AT(p.g), "acceleration of the striker towards the specimen [m/s^2] (default 0; 9.81 for gravity)", "g", NULL},
-    {"--gap0", REAL, AT(p.gap0), "gap between striker and specimen at t = 0 [m] (default 0)", "gap0", NULL},
-    {"--t-end", REAL, AT(p.t_end), "stop at this time if the solve has not stopped before [s] (default 1)", "t_end",
-     NULL},
-    {"--impacts", INTEGER, AT(p.impacts), "stop right after this many impacts have ended (default 1)", "impacts",
-     NULL},
-    {"--output-interval", REAL, AT(output_interval), "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row after every internal step (large). Default: 1/256 of the elastic Hertz contact time at the impact speed (about 250 rows per contact; 4.8 us at the h20 defaults), or --t-end / 1000 in the driven scene without mass", NULL, finite_nonnegative},
-    {"--csv", TEXT, AT(csv), "write the time series to FILE: t, F, x, x1, x2, v, E_diss (SI units)", NULL, NULL},
-    {"--json", FLAG, AT(json), "print one JSON object instead of the table", NULL, NULL},
-    {"--reference", FLAG, AT(reference), "solve with GSL's high-accuracy integrator instead of the model's scheme", NULL, NULL},
-    {"--rtol", REAL, AT(rtol), "relative tolerance of --reference (default 1e-12)", NULL, between_0_and_1},
-    {"--repeat", INTEGER, AT(repeat), "solve this many times and report the median cpu_seconds (default 1; for timing)", NULL, repeat_count},
-    {"--quiet", FLAG, AT(quiet), "no progress line on a terminal", NULL, NULL},
-};
-#define N_OPTIONS (sizeof table / sizeof table[0])
-typedef char options_fit_in_typed[N_OPTIONS <= N_OPTIONS_MAX ? 1 : -1];
-
-static void usage(FILE *out)
-{
-    size_t i;
-    fprintf(out,
-            "usage: " PROGRAM " [OPTION VALUE]... [--json] [--reference]\n"
-            "Simulates an impact on a Hertz spring in series with a dashpot, the spring force\n"
-            "computed by the G1 Grunwald-Letnikov semi-integral (MODEL.md). Defaults: the paper's\n"
-            "h20 drop test. Options take a value as '--opt VALUE' or '--opt=VALUE'.\n\n");
-    for (i = 0; i < N_OPTIONS; i++)
-        fprintf(out, "  %-18s %s\n", table[i].name, table[i].help);
-    fprintf(out, "  %-18s %s\n", "--list-options", "print this table as JSON (option, kind, help, choices) and exit");
-    fprintf(out, "  %-18s %s\n\n", "--help", "this text");
-    fprintf(out,
-            "The solve stops at the first of: --impacts impacts ended, --t-end, or the striker out of\n"
-            "contact moving away with nothing to bring it back (no gravity, say).\n\n"
-            "Output (table, or --json keys):\n"
-            "  per_impact   one entry for every finished impact, in order: t_onset [s], v_onset [m/s],\n"
-            "               F_peak [N], eps, t_contact [s], x2_end [m] (the permanent indentation when it\n"
-            "               ended, left by all impacts so far), E_diss [J] (dissipated during it)\n"
-            "  F_peak [N]   the largest force of the whole solve (all impacts, and a contact still going)\n"
-            "  eps, t_contact [s]   of the last finished impact (0 when none ended)\n"
-            "  x_perm [m], E_diss [J]   permanent indentation and energy dissipated where the solve\n"
-            "               stopped, summed over every impact\n"
-            "  v_end [m/s], x_end [m], x1_end [m]   striker velocity, total and elastic indentation there\n"
-            "  impacts      finished impacts; separated: whether any impact ended\n"
-            "  stopped      why the solve stopped: impacts, t_end or receding\n"
-            "  t_end [s]    where it stopped\n"
-            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
-            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
-}
-
 static const char *const law_words[] = {"g1", "hertz", "g1x", NULL};
 static const char *const scheme_words[] = {"sdirk2", "central", NULL};
 static const char *const scene_words[] = {"drop", "driven", NULL};
+
+/* The words an integer parameter also takes, and its kind. */
+static option_kind word_kind(const char *name, const char *const **words)
+{
+    *words = strcmp(name, "law") == 0 ? law_words : strcmp(name, "scheme") == 0 ? scheme_words
+             : strcmp(name, "scene") == 0 ? scene_words : NULL;
+    return !*words ? INTEGER : strcmp(name, "law") == 0 ? LAW : strcmp(name, "scheme") == 0 ? SCHEME : SCENE;
+}
+
+static void add_option(option_table *t, const char *name, option_kind kind, size_t offset, const char *variable,
+                       option_rule rule, const char *help)
+{
+    option *o = &t->list[t->n++];
+    snprintf(o->name, sizeof o->name, "%s", name);
+    o->kind = kind;
+    o->offset = offset;
+    o->variable = variable;
+    o->rule = rule;
+    snprintf(o->help, sizeof o->help, "%s", help);
+}
+
+/* One option per parameter of the library, --NAME with '_' as '-', its help
+ * with unit and default from the library; then the solver's own options. */
+static void make_options(option_table *t)
+{
+    fc_params defaults;
+    size_t i;
+    fc_params_default(&defaults);
+    t->n = 0;
+    add_option(t, "--height", REAL, offsetof(options, height), NULL, finite_nonnegative,
+               "drop height h [m]: v = sqrt(2 * 9.81 * h) (instead of --v)");
+    for (i = 0; i < fc_parameter_count(); i++) {
+        const fc_parameter *p = fc_parameter_at(i);
+        const char *const *words;
+        const void *value = (const char *)&defaults + p->offset;
+        char name[32], help[512], shown[64];
+        size_t k, w;
+        option_kind kind = p->kind == FC_REAL ? REAL : word_kind(p->name, &words);
+        snprintf(name, sizeof name, "--%s", p->name);
+        for (k = 2; name[k]; k++)
+            name[k] = name[k] == '_' ? '-' : name[k];
+        if (p->kind == FC_REAL)
+            snprintf(shown, sizeof shown, "%g", *(const double *)value);
+        else
+            snprintf(shown, sizeof shown, "%d", *(const int *)value);
+        snprintf(help, sizeof help, "%s [%s] (default %s)", p->help, p->unit, shown);
+        if (kind != REAL && kind != INTEGER)
+            for (w = 0; words[w]; w++)
+                snprintf(help + strlen(help), sizeof help - strlen(help), "%s%s", w ? ", " : "; or ", words[w]);
+        add_option(t, name, kind, offsetof(options, p) + p->offset, p->name, NULL, help);
+    }
+    add_option(t, "--output-interval", REAL, offsetof(options, output_interval), NULL, finite_nonnegative,
+               "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row "
+               "after every internal step (large). Default: 1/256 of the elastic Hertz contact time at the impact "
+               "speed (about 250 rows per contact; 4.8 us at the h20 defaults), or --t-end / 1000 in the driven "
+               "scene without mass");
+    add_option(t, "--csv", TEXT, offsetof(options, csv), NULL, NULL,
+               "write the time series to FILE, columns t [s], F [N], x, x1, x2 [m], v [m/s], E_diss [J]");
+    add_option(t, "--json", FLAG, offsetof(options, json), NULL, NULL, "print one JSON object instead of the table");
+    add_option(t, "--reference", FLAG, offsetof(options, reference), NULL, NULL,
+               "solve with GSL's high-accuracy integrator instead of the model's scheme");
+    add_option(t, "--rtol", REAL, offsetof(options, rtol), NULL, between_0_and_1,
+               "relative tolerance of --reference (default 1e-12)");
+    add_option(t, "--repeat", INTEGER, offsetof(options, repeat), NULL, repeat_count,
+               "solve this many times and report the median cpu_seconds (default 1; for timing)");
+    add_option(t, "--quiet", FLAG, offsetof(options, quiet), NULL, NULL, "no progress line on a terminal");
+}
+
+static void usage(const option_table *t)
+{
+    size_t i;
+    printf("usage: " PROGRAM " [OPTION VALUE]... [--json] [--reference]\n"
+           "Simulates an impact on a Hertz spring in series with a dashpot, the spring force\n"
+           "computed by the G1 Grunwald-Letnikov semi-integral (MODEL.md). Defaults: the paper's\n"
+           "h20 drop test. Options take a value as '--opt VALUE' or '--opt=VALUE'; the model's\n"
+           "options are the FMU's variables (--dt-max for dt_max).\n\n");
+    for (i = 0; i < t->n; i++)
+        printf("  %-18s %s\n", t->list[i].name, t->list[i].help);
+    printf("  %-18s %s\n", "--list-options", "print this table as JSON (option, kind, help, choices) and exit");
+    printf("  %-18s %s\n\n", "--help", "this text");
+    printf("The solve stops at the first of: --impacts impacts ended, --t-end, or the striker out of\n"
+           "contact moving away with nothing to bring it back (no gravity, say).\n\n"
+           "Output (table, or --json keys):\n"
+           "  t_onset [s], v_onset [m/s], F_peak [N], eps, t_contact [s], x2_end [m], E_diss [J]\n"
+           "               the first impact's figures (null when none ended): onset time and speed,\n"
+           "               largest force, restitution coefficient, contact duration, the permanent\n"
+           "               indentation when it ended, the energy it dissipated\n"
+           "  per_impact   the same for every finished impact, in order (x2_end: the dent left by all\n"
+           "               impacts so far)\n"
+           "  end          the FMU's outputs where the solve stopped: t [s], F_peak [N] (the largest\n"
+           "               of the solve), eps and t_contact [s] (of the last finished impact), E_diss [J]\n"
+           "               (of all impacts), x, x1, x2 [m], v [m/s] (the striker's velocity)\n"
+           "  stopped      why the solve stopped: impacts, t_end or receding\n"
+           "  impacts      finished impacts\n"
+           "  steps        internal steps (the reference: right-hand-side evaluations)\n"
+           "  cpu_seconds  of the solve alone (the median over --repeat)\n"
+           "  method, k    sdirk2, central or reference; the Hertz constant used [N/m1.5]\n"
+           "  params       every parameter of the run, by the FMU's names\n"
+           "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
+}
 
 static void print_json_string(const char *text)
 {
@@ -147,22 +184,20 @@ static void print_json_string(const char *text)
     putchar('"');
 }
 
-/* The option table as JSON, for programs that drive the solver (the sweep):
- * one table, never a copy of it. */
-static void list_options(void)
+/* The option table as JSON, for programs that drive the solver. */
+static void list_options(const option_table *t)
 {
     static const char *const kinds[] = {"real", "integer", "word", "word", "word", "text", "flag"};
     size_t i;
     printf("[");
-    for (i = 0; i < N_OPTIONS; i++) {
-        const char *const *words = table[i].kind == LAW      ? law_words
-                                   : table[i].kind == SCHEME ? scheme_words
-                                   : table[i].kind == SCENE  ? scene_words
-                                                             : NULL;
+    for (i = 0; i < t->n; i++) {
+        const option *o = &t->list[i];
+        const char *const *words = o->kind == LAW ? law_words : o->kind == SCHEME ? scheme_words
+                                   : o->kind == SCENE ? scene_words : NULL;
         printf("%s\n {\"option\": ", i ? "," : "");
-        print_json_string(table[i].name);
-        printf(", \"kind\": \"%s\", \"help\": ", kinds[table[i].kind]);
-        print_json_string(table[i].help);
+        print_json_string(o->name);
+        printf(", \"kind\": \"%s\", \"help\": ", kinds[o->kind]);
+        print_json_string(o->help);
         if (words) {
             int w;
             printf(", \"choices\": [");
@@ -236,34 +271,34 @@ static int set_option(options *o, const option *opt, const char *value)
     return broken ? bad_option(opt->name, value, broken) : 0;
 }
 
-/* The model's own checks; its message names its variable, which names the
+/* The library's own checks; its message names its variable, which names the
  * option and the value as typed. */
-static int check_model(const options *o)
+static int check_model(const option_table *t, const options *o)
 {
     char why[FC_MESSAGE_SIZE];
     size_t k, n;
     if (fc_params_check(&o->p, why, sizeof why) == FC_OK)
         return 0;
     n = strcspn(why, " ");
-    for (k = 0; k < N_OPTIONS; k++)
-        if (o->typed[k] && table[k].variable && strlen(table[k].variable) == n
-            && strncmp(why, table[k].variable, n) == 0)
-            return bad_option(table[k].name, o->typed[k], why);
+    for (k = 0; k < t->n; k++)
+        if (o->typed[k] && t->list[k].variable && strlen(t->list[k].variable) == n
+            && strncmp(why, t->list[k].variable, n) == 0)
+            return bad_option(t->list[k].name, o->typed[k], why);
     fprintf(stderr, PROGRAM ": %s (see --help)\n", why);
     return 2;
 }
 
-static const char *typed_value(const options *o, const char *name)
+static const char *typed_value(const option_table *t, const options *o, const char *name)
 {
     size_t k;
-    for (k = 0; k < N_OPTIONS; k++)
-        if (strcmp(table[k].name, name) == 0)
+    for (k = 0; k < t->n; k++)
+        if (strcmp(t->list[k].name, name) == 0)
             return o->typed[k];
     return NULL;
 }
 
 /* Returns 0, 2 for bad options, or -1 after --help or --list-options. */
-static int parse(int argc, char **argv, options *o)
+static int parse(int argc, char **argv, const option_table *t, options *o)
 {
     int i;
     size_t k;
@@ -273,17 +308,17 @@ static int parse(int argc, char **argv, options *o)
         const char *value = NULL, *eq = strchr(argv[i], '=');
         const option *opt = NULL;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
+            usage(t);
             return -1;
         }
         if (strcmp(argv[i], "--list-options") == 0) {
-            list_options();
+            list_options(t);
             return -1;
         }
         snprintf(name, sizeof name, "%.*s", eq ? (int)(eq - argv[i]) : (int)strlen(argv[i]), argv[i]);
-        for (k = 0; k < N_OPTIONS; k++)
-            if (strcmp(name, table[k].name) == 0)
-                opt = &table[k];
+        for (k = 0; k < t->n; k++)
+            if (strcmp(name, t->list[k].name) == 0)
+                opt = &t->list[k];
         if (!opt)
             return bad_option("option", argv[i], "unknown");
         if (opt->kind == FLAG) {
@@ -298,11 +333,14 @@ static int parse(int argc, char **argv, options *o)
             return bad_option(name, "", "needs a value");
         if (set_option(o, opt, value) != 0)
             return 2;
-        o->typed[opt - table] = value;
+        o->typed[opt - t->list] = value;
     }
-    if (typed_value(o, "--height"))
+    if (typed_value(t, o, "--height")) {
+        if (typed_value(t, o, "--v"))
+            return bad_option("--height", typed_value(t, o, "--height"), "give --height or --v, not both");
         o->p.v = fc_drop_velocity(o->height);
-    if (check_model(o) != 0)
+    }
+    if (check_model(t, o) != 0)
         return 2;
     if (fc_params_warning(&o->p, warning, sizeof warning))
         fprintf(stderr, PROGRAM ": warning: %s\n", warning);
@@ -388,7 +426,7 @@ static int write_csv_rows(const char *tmp, const char *path, const double *rows,
         perror(NULL);
         return -1;
     }
-    fprintf(f, "t_s,F_N,x_m,x1_m,x2_m,v_m_per_s,E_diss_J\n");
+    fprintf(f, "t,F,x,x1,x2,v,E_diss\n");
     for (i = 0; i < n; i++) {
         const double *r = rows + i * FC_COLUMNS;
         fprintf(f, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", r[FC_T], r[FC_F], r[FC_X], r[FC_X1], r[FC_X2],
@@ -410,39 +448,69 @@ static const char *stop_name(int stop)
     return stop == FC_STOP_IMPACTS ? "impacts" : stop == FC_STOP_T_END ? "t_end" : "receding";
 }
 
+static const char *method_name(const options *o)
+{
+    return o->reference ? "reference" : o->p.scheme == 2 ? "central" : "sdirk2";
+}
+
+/* "name": value for each figure of an impact; null for a missing one. */
+static void print_impact_json(const fc_impact *i, int ended)
+{
+    const double figures[] = {i->t_onset, i->v_onset, i->F_peak, i->eps, i->t_contact, i->x2_end, i->E_diss};
+    static const char *const names[] = {"t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss"};
+    size_t k;
+    for (k = 0; k < sizeof names / sizeof names[0]; k++) {
+        if (ended)
+            printf("%s\"%s\": %.17g", k ? ", " : "", names[k], figures[k]);
+        else
+            printf("%s\"%s\": null", k ? ", " : "", names[k]);
+    }
+}
+
+static void print_params_json(const fc_params *p)
+{
+    size_t i;
+    for (i = 0; i < fc_parameter_count(); i++) {
+        const fc_parameter *q = fc_parameter_at(i);
+        const void *value = (const char *)p + q->offset;
+        if (q->kind == FC_REAL)
+            printf("%s\"%s\": %.17g", i ? ", " : "", q->name, *(const double *)value);
+        else
+            printf("%s\"%s\": %d", i ? ", " : "", q->name, *(const int *)value);
+    }
+}
+
 static void print_json(const options *o, const fc_result *r, double cpu_seconds)
 {
-    static const char *const laws[] = {"", "g1", "hertz", "g1x"};
-    static const char *const schemes[] = {"", "sdirk2", "central"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("{\"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, \"x_perm\": %.17g, "
-           "\"E_diss\": %.17g, \"v_end\": %.17g, \"x_end\": %.17g, \"x1_end\": %.17g, "
-           "\"steps\": %" PRId64 ", \"cpu_seconds\": %.9g, \"impacts\": %" PRId64 ", \"separated\": %s, "
-           "\"stopped\": \"%s\", \"t_end\": %.17g, \"law\": \"%s\", \"method\": \"%s\", \"dt\": %.17g, "
-           "\"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v0\": %.17g, \"per_impact\": [",
-           f->F_peak, f->eps, f->t_contact, f->x2, f->E_diss, f->v, f->x, f->x1, f->steps, cpu_seconds,
-           f->impacts, f->impacts > 0 ? "true" : "false", stop_name(f->stop), f->t, laws[o->p.law],
-           o->reference ? "reference" : schemes[o->p.scheme], o->p.dt_max, f->k, o->p.c, o->p.m, o->p.v);
+    printf("{");
+    print_impact_json(&f->first, f->impacts > 0);
+    printf(", \"per_impact\": [");
     for (i = 0; i < r->n_impacts; i++) {
-        const fc_impact *p = &r->per_impact[i];
-        printf("%s{\"t_onset\": %.17g, \"v_onset\": %.17g, \"F_peak\": %.17g, \"eps\": %.17g, "
-               "\"t_contact\": %.17g, \"x2_end\": %.17g, \"E_diss\": %.17g}",
-               i ? ", " : "", p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
+        printf("%s{", i ? ", " : "");
+        print_impact_json(&r->per_impact[i], 1);
+        printf("}");
     }
-    printf("]}\n");
+    printf("], \"end\": {\"t\": %.17g, \"F_peak\": %.17g, \"eps\": %.17g, \"t_contact\": %.17g, "
+           "\"E_diss\": %.17g, \"x\": %.17g, \"x1\": %.17g, \"x2\": %.17g, \"v\": %.17g}, "
+           "\"stopped\": \"%s\", \"impacts\": %" PRId64 ", \"steps\": %" PRId64 ", \"cpu_seconds\": %.9g, "
+           "\"method\": \"%s\", \"k\": %.17g, \"params\": {",
+           f->t, f->F_peak, f->eps, f->t_contact, f->E_diss, f->x, f->x1, f->x2, f->v, stop_name(f->stop),
+           f->impacts, f->steps, cpu_seconds, method_name(o), f->k);
+    print_params_json(&o->p);
+    printf("}}\n");
 }
 
 static void print_table(const options *o, const fc_result *r, double cpu_seconds)
 {
     static const char *const laws[] = {"", "g1", "hertz", "g1x"};
-    static const char *const schemes[] = {"", "sdirk2", "central"};
     static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
                                         "the striker moves away and nothing brings it back"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v0 = %.6g m/s\n",
-           o->reference ? "reference" : schemes[o->p.scheme], laws[o->p.law], f->k, o->p.c, o->p.m, o->p.v);
+    printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v = %.6g m/s\n", method_name(o),
+           laws[o->p.law], f->k, o->p.c, o->p.m, o->p.v);
     if (r->n_impacts > 0) {
         printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");
         for (i = 0; i < r->n_impacts; i++) {
@@ -450,17 +518,12 @@ static void print_table(const options *o, const fc_result *r, double cpu_seconds
             printf("  %6lu  %11.6g  %13.6g  %10.6g  %9.6g  %13.6g  %10.6g  %10.6g\n", (unsigned long)(i + 1),
                    p->t_onset, p->v_onset, p->F_peak, p->eps, p->t_contact, p->x2_end, p->E_diss);
         }
-    }
-    printf("  F_peak     %.10g N (largest of the solve)\n", f->F_peak);
-    printf("  eps        %.10g (last finished impact)\n", f->eps);
-    printf("  t_contact  %.10g s (last finished impact)\n", f->t_contact);
-    printf("  x_perm     %.10g m (where the solve stopped)\n", f->x2);
-    printf("  E_diss     %.10g J (all impacts)\n", f->E_diss);
-    printf("  v_end      %.10g m/s\n", f->v);
-    printf("  impacts    %" PRId64 "\n", f->impacts);
-    printf("  stopped    at t = %.6g s: %s\n", f->t, stops[f->stop]);
-    printf("  steps      %" PRId64 "\n", f->steps);
-    printf("  cpu        %.6g s\n", cpu_seconds);
+    } else
+        printf("  no impact ended\n");
+    printf("  at the end: t = %.6g s, F_peak %.10g N (largest of the solve), x2 %.10g m, E_diss %.10g J,\n"
+           "              v %.10g m/s\n", f->t, f->F_peak, f->x2, f->E_diss, f->v);
+    printf("  stopped     %s\n", stops[f->stop]);
+    printf("  steps       %" PRId64 ", cpu %.6g s\n", f->steps, cpu_seconds);
 }
 
 /* ------------------------------------------------------------ the solves */
@@ -537,6 +600,7 @@ static double solve(const options *o, double interval, fc_result *r)
 
 int main(int argc, char **argv)
 {
+    option_table table;
     options o;
     fc_result r;
     double interval, seconds;
@@ -545,10 +609,11 @@ int main(int argc, char **argv)
     fc_params_default(&o.p);
     o.repeat = 1;
     o.rtol = 1e-12;
-    status = parse(argc, argv, &o);
+    make_options(&table);
+    status = parse(argc, argv, &table, &o);
     if (status != 0)
         return status < 0 ? 0 : status;
-    interval = !o.csv ? FC_NO_ROWS : typed_value(&o, "--output-interval") ? o.output_interval
+    interval = !o.csv ? FC_NO_ROWS : typed_value(&table, &o, "--output-interval") ? o.output_interval
                                                                             : fc_default_output_interval(&o.p);
     seconds = solve(&o, interval, &r);
     status = seconds < 0.0 || (o.csv && write_csv(o.csv, r.rows, r.n_rows) != 0);

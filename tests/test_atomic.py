@@ -113,7 +113,7 @@ def test_a_solver_killed_while_writing_its_csv_leaves_nothing(tmp_path):
     to write after a 0.2 s solve): the signal goes as soon as the first
     bytes are seen, with seconds of writing left."""
     target = tmp_path / "h20.csv"
-    run = subprocess.Popen([SOLVE, "--law", "hertz", "--dt", "1e-9", "--output-interval", "0", "--csv", str(target),
+    run = subprocess.Popen([SOLVE, "--law", "hertz", "--dt-max", "1e-9", "--output-interval", "0", "--csv", str(target),
                             "--quiet"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     first = wait_for_first_write(tmp_path, run)
     assert first != target                               # written aside first

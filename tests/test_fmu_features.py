@@ -161,7 +161,7 @@ GAP, GRAVITY = 2e-3, 9.81
 @pytest.fixture(scope="module")
 def gravity_reference():
     """GSL's solve of the drop test with g and a gap, three impacts."""
-    return reference("--g", GRAVITY, "--gap0", GAP, "--v0", repr(V0), "--impacts", 3)["per_impact"]
+    return reference("--g", GRAVITY, "--gap0", GAP, "--v", repr(V0), "--impacts", 3)["per_impact"]
 
 
 def first_impact(s):

@@ -87,7 +87,7 @@ def test_created_energy_fails(h20):
 
 def test_momentum_off_fails(h20):
     case, r = h20
-    r = dict(r, x_perm=r["x_perm"] * (1 + 1e-9))
+    r = dict(r, x2=r["x2"] * (1 + 1e-9))
     assert stability.invariants(case, r)[0]["momentum"]
 
 

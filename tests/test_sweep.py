@@ -60,7 +60,6 @@ def assert_row_is_the_solver_result(row, direct, inputs):
             continue
         column = f"{key}_result" if key in inputs else key
         assert float(row[column]) == pytest.approx(value, rel=1e-12, abs=0), key
-    assert row["separated"] == str(direct["separated"])
 
 
 @pytest.fixture(scope="module")
@@ -183,10 +182,11 @@ def test_statistics_are_numpys_on_the_csv(monte_carlo):
     columns = [key for key in rows[0] if all(number(r[key]) is not None for r in rows)]
     statistics = json.loads((out / "sweep.json").read_text())["statistics"]
     assert set(statistics) == set(columns)
-    assert {"F_peak", "eps", "t_contact", "x_perm", "E_diss", "k", "c"} <= set(columns)
+    assert {"F_peak", "eps", "t_contact", "x2_end", "E_diss", "k", "c"} <= set(columns)
     lines = {line.split()[0]: line.split()[1:] for line in printed.splitlines() if line.split()}
     for key in columns:
         x = np.array([float(r[key]) for r in rows])
+        x = x[np.isfinite(x)]  # a figure of an impact that did not end by t_end is NaN, not a value
         truth = dict(mean=x.mean(), std=x.std(ddof=1), p5=np.percentile(x, 5), p50=np.percentile(x, 50),
                      p95=np.percentile(x, 95))
         assert statistics[key] == pytest.approx(truth, rel=1e-12, abs=1e-300), key
