@@ -27,6 +27,8 @@ def test_impact_is_the_drop_test_of_scipy():
     assert r.per_impact == [fraccontact.Impact(r.t_onset, r.v_onset, r.F_peak, r.eps, r.t_contact, r.x2_end,
                                                r.E_diss)]
     assert r.stopped == "impacts" and r.impacts == 1 and r.t_onset == 0 and r.v_onset == V0
+    assert r.end.t == r.t_contact and r.end.x2 == r.x2_end and r.end.x1 == 0
+    assert r.end.v == pytest.approx(-r.eps * V0, rel=2 ** -52, abs=0)  # eps = -v / v_onset, one rounding
     assert fraccontact.impact().v_onset == 0.626418  # the FMU's start value
 
 
@@ -47,6 +49,8 @@ def test_a_batch_is_the_same_runs_one_by_one():
             for key in ("F_peak", "eps", "t_contact", "x2_end", "E_diss", "t_onset", "v_onset"):
                 assert a[key][i, j] == getattr(r, key), (key, i, j)
             assert a["impacts"][i, j] == 1 and a["stopped"][i, j] == "impacts"
+            for key in ("t", "F_peak", "x2", "v"):
+                assert a["end"][key][i, j] == getattr(r.end, key), (key, i, j)
 
 
 def test_word_values_as_arrays():
@@ -86,7 +90,7 @@ def test_simulate_gives_the_run_and_rows_on_its_grid():
     run = s["run"]
     assert s["t"][0] == 0 and np.all(np.diff(s["t"]) > 0)
     on_grid = s["t"][1:-1][np.abs(s["t"][1:-1] / 1e-5 - np.round(s["t"][1:-1] / 1e-5)) < 1e-9]
-    assert len(on_grid) == math.floor(run.t / 1e-5)
+    assert len(on_grid) == math.floor(run.end.t / 1e-5)
     assert s["F"].max() <= run.F_peak and s["F"].max() > 0.999 * run.F_peak
     assert s["x"] == pytest.approx(s["x1"] + s["x2"], rel=1e-15, abs=1e-20)
     assert run == fraccontact.impact(law="hertz")  # the rows change nothing

@@ -100,9 +100,27 @@ def _impact(c):
 
 
 @dataclass
+class End:
+    """The FMU's outputs where a run stopped."""
+    t: float          # time [s]
+    F_peak: float     # the largest force of the run [N]
+    eps: float        # restitution coefficient of the last finished impact (0 when none)
+    t_contact: float  # duration of the last finished impact [s]
+    E_diss: float     # energy dissipated in all [J]
+    x: float          # total indentation [m]
+    x1: float         # elastic indentation [m]
+    x2: float         # permanent indentation [m]
+    v: float          # striker velocity [m/s]
+
+
+END_FIGURES = tuple(End.__dataclass_fields__)
+
+
+@dataclass
 class Run:
-    """A run: the figures of its first impact as attributes (NaN when no
-    impact ended), every finished impact in per_impact, and where it stopped."""
+    """A run, as fraccontact-solve --json gives it: the figures of its first
+    impact as attributes (NaN when no impact ended), every finished impact in
+    per_impact, the FMU's outputs where it stopped in end, and why."""
     t_onset: float
     v_onset: float
     F_peak: float
@@ -111,23 +129,17 @@ class Run:
     x2_end: float
     E_diss: float
     per_impact: list = field(default_factory=list)
-    stopped: str = ""        # impacts, t_end or receding
-    impacts: int = 0         # finished impacts
-    steps: int = 0           # internal steps
-    t: float = 0.0           # where the run stopped [s]
-    x: float = 0.0           # total indentation there [m]
-    x1: float = 0.0          # elastic indentation there [m]
-    x2: float = 0.0          # permanent indentation there [m]
-    v: float = 0.0           # striker velocity there [m/s]
-    F_peak_run: float = 0.0  # the largest force of the whole run [N]
-    E_diss_run: float = 0.0  # energy dissipated in all [J]
-    k: float = 0.0           # the Hertz constant used [N/m^1.5]
+    end: End = None
+    stopped: str = ""  # impacts, t_end or receding
+    impacts: int = 0   # finished impacts
+    steps: int = 0     # internal steps
+    k: float = 0.0     # the Hertz constant used [N/m1.5]
 
 
 def _run(o, per_impact):
     first = [getattr(o.first, name) if o.impacts else math.nan for name in IMPACT_FIGURES]
-    return Run(*first, per_impact=per_impact, stopped=_lib.STOPS[o.stop], impacts=o.impacts, steps=o.steps,
-               t=o.t, x=o.x, x1=o.x1, x2=o.x2, v=o.v, F_peak_run=o.F_peak, E_diss_run=o.E_diss, k=o.k)
+    return Run(*first, per_impact=per_impact, end=End(*(getattr(o, name) for name in END_FIGURES)),
+               stopped=_lib.STOPS[o.stop], impacts=o.impacts, steps=o.steps, k=o.k)
 
 
 def _call_run(p, interval):
@@ -168,28 +180,25 @@ def simulate(output_interval=None, **params):
 
 def impacts(**params):
     """Many runs in one library call. Any parameter may be a NumPy array;
-    they broadcast together. Returns a dict of arrays of the broadcast shape:
-    the first impact's figures (NaN where none ended), and impacts, steps,
-    stopped, F_peak_run, E_diss_run, t, x2 of each run."""
+    they broadcast together. Returns a dict of arrays of the broadcast shape,
+    named as Run's: the first impact's figures (NaN where none ended),
+    impacts, steps, stopped, k, and "end", a dict of the end's arrays."""
     given = _given(params)
     names = list(given)
     values = np.broadcast_arrays(*[_words_to_numbers(name, given[name]) for name in names]) if names else []
     shape = values[0].shape if names else ()
     batch = np.empty(int(np.prod(shape)), dtype=np.dtype(_lib.Params))
-    default = np.frombuffer(bytes(_default_params()), dtype=np.dtype(_lib.Params))[0]
-    batch[:] = default
+    batch[:] = np.frombuffer(bytes(_default_params()), dtype=np.dtype(_lib.Params))[0]
     for name, value in zip(names, values):
         batch[name] = value.ravel()
     out = np.zeros(len(batch), dtype=np.dtype(_lib.Outcome))
-    status = _lib.LIB.fc_run_batch(len(batch), batch.ctypes.data, out.ctypes.data)
-    if status != _lib.FC_OK:
+    if _lib.LIB.fc_run_batch(len(batch), batch.ctypes.data, out.ctypes.data) != _lib.FC_OK:
         _raise_for_case(batch, out, shape)
     ended = out["impacts"] > 0
     result = {name: np.where(ended, out["first"][name], np.nan).reshape(shape) for name in IMPACT_FIGURES}
     result.update(impacts=out["impacts"].reshape(shape), steps=out["steps"].reshape(shape),
                   stopped=np.array([_lib.STOPS.get(s, "") for s in out["stop"]]).reshape(shape),
-                  F_peak_run=out["F_peak"].reshape(shape), E_diss_run=out["E_diss"].reshape(shape),
-                  t=out["t"].reshape(shape), x2=out["x2"].reshape(shape))
+                  k=out["k"].reshape(shape), end={name: out[name].reshape(shape) for name in END_FIGURES})
     return result
 
 
