@@ -4,7 +4,11 @@
  *                                     the literal O(N) G1 sum per step
  *   fraccontact-bench g1 N ALPHA      the bare G1 history sum of f(x) = x on
  *                                     N intervals of [0, 1]: newest point and
- *                                     full grid, timed and checked at every point */
+ *                                     full grid, timed and checked at every point
+ *   fraccontact-bench batch N LAW DT_MAX
+ *                                     the library's own CPU for N h20 impacts in
+ *                                     one fc_run_batch call (the C core's cost of
+ *                                     what fraccontact.impacts does from Python) */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
@@ -13,6 +17,7 @@
 #include <string.h>
 
 #include "contact.h"
+#include "fraccontact.h"
 #include "g1.h"
 #include "g1_grid.h"
 #include "timing.h"
@@ -130,12 +135,44 @@ static int bench_g1(size_t N, double alpha)
     return 0;
 }
 
+/* CPU per impact of N h20 impacts (dashpots spread over 4000..8000 N s/m,
+ * as a sweep would) in one batch call: the median of 5. */
+static int bench_batch(size_t N, int law, double dt_max)
+{
+    fc_params *p = malloc(N * sizeof *p);
+    fc_outcome *out = malloc(N * sizeof *out);
+    double runs[5];
+    size_t i;
+    int r;
+    if (!p || !out)
+        return 1;
+    for (i = 0; i < N; i++) {
+        fc_params_default(&p[i]);
+        p[i].law = law;
+        p[i].dt_max = dt_max;
+        p[i].c = 4000.0 + 4000.0 * (double)i / (double)N;
+    }
+    for (r = 0; r < 5; r++) {
+        double t0 = cpu_seconds();
+        if (fc_run_batch(N, p, out) != FC_OK)
+            return 1;
+        runs[r] = (cpu_seconds() - t0) / (double)N;
+    }
+    printf("{\"N\": %lu, \"law\": %d, \"dt_max\": %g, \"seconds_per_impact\": %.6g, \"F_peak_first\": %.17g}\n",
+           (unsigned long)N, law, dt_max, median(runs, 5), out[0].first.F_peak);
+    free(p);
+    free(out);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 5 && strcmp(argv[1], "batch") == 0 && atol(argv[2]) > 0)
+        return bench_batch((size_t)atol(argv[2]), atoi(argv[3]), atof(argv[4]));
     if (argc == 2 && strcmp(argv[1], "step") == 0)
         return bench_step();
     if (argc == 4 && strcmp(argv[1], "g1") == 0 && atol(argv[2]) > 0)
         return bench_g1((size_t)atol(argv[2]), atof(argv[3]));
-    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA\n");
+    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX\n");
     return 2;
 }
