@@ -2,7 +2,8 @@
 internal steps with resident memory sampled, hours of bouncing through the
 FMU, valgrind memcheck over the C tests, the fuzzer's executions and the
 line coverage its corpus reaches, and the hostile-input table. Writes
-docs/reliability.md (and docs/reliability_hostile.md).
+docs/reliability.md (and docs/reliability_hostile.md), keeping its mutation
+section (scripts/report mutation) as it is.
 
 Regenerate: scripts/report reliability   (about ten minutes; builds build-fuzz and build-coverage)
 """
@@ -88,6 +89,17 @@ def fuzz(seconds):
                 corpus=len(inputs), crashed=done.returncode != 0, report=report)
 
 
+MUTATION_BEGIN, MUTATION_END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
+
+
+def mutation_section(path):
+    """The mutation table (scripts/report mutation) lives in the same file
+    but is another report's: it is kept as it is, markers included."""
+    text = path.read_text() if path.exists() else ""
+    start, end = text.find(MUTATION_BEGIN), text.find(MUTATION_END)
+    return text[start:end + len(MUTATION_END)] + "\n" if 0 <= start < end else ""
+
+
 def write(path, s, v, f, hostile_summary):
     steps = s["steps"]
     lines = ["# Reliability", "",
@@ -139,7 +151,8 @@ def write(path, s, v, f, hostile_summary):
               "## Hostile and degenerate input", "",
               f"{hostile_summary} The table, case by case: [reliability_hostile.md](reliability_hostile.md) "
               "(`scripts/report hostile`); pytest runs the same cases in CI (`tests/test_hostile.py`)."]
-    atomic.write_text(path, "\n".join(lines) + "\n")
+    kept = mutation_section(path)
+    atomic.write_text(path, "\n".join(lines) + "\n" + ("\n" + kept if kept else ""))
 
 
 def main():

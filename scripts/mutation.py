@@ -1,0 +1,593 @@
+"""Mutation testing: does the test suite notice a small wrong change to the
+code it tests? Each mutant is one precise edit (or a few) of the C sources:
+the force laws, the G1 weights and sums, the time scheme, the events, the
+proxy striker, gravity and the gap, the FMU state's CRC and fields, the
+outputs' scaling, the FMI call sequence and the solver's per-impact figures.
+Each numeric mutant is perturbed by a little more (two to three times) than
+the smallest error that the named test's stated tolerance claims to catch.
+
+The mutants are applied to a copy of the working tree (its tracked and
+untracked, not ignored, files: work not yet committed is tested too), never
+to the sources themselves. Every edit's original text must occur exactly once
+in its file, or the run stops before building anything: the source moved and
+the mutant must be rewritten. For each mutant the copy is rebuilt
+incrementally, then the C tests run (ctest, stopping at the first failure),
+then pytest with -x (test files in alphabetical order, the slow
+test_stability, test_sweep and test_fit last). The mutant is KILLED by the
+first test that fails, or SURVIVES. The unmutated copy runs every test
+first: one that fails there (work in progress) is left out of the mutant
+runs and named in the report (--strict-baseline stops instead).
+
+Writes the table between the markers <!-- mutation:begin --> and
+<!-- mutation:end --> of docs/reliability.md (appended when missing;
+scripts/reliability.py keeps that section when it rewrites the file).
+
+Regenerate: scripts/report mutation   (about ten minutes on 2 cores: a killed
+mutant costs a rebuild and the tests up to its first failure, seconds; a
+survivor the whole suite, about a minute; the baseline one more)
+  scripts/report mutation --list               the mutants, checked against the sources
+  scripts/report mutation --only NAME [NAME...]  run some, print, leave the docs alone
+"""
+
+import argparse
+import concurrent.futures
+import dataclasses
+import datetime
+import json
+import os
+import pathlib
+import re
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import atomic
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+DOC = ROOT / "docs" / "reliability.md"
+BEGIN, END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
+SLOW_LAST = ["test_stability.py", "test_sweep.py", "test_fit.py"]  # pytest runs these last, in this order
+PYTHON = ROOT / ".venv" / "bin" / "python"
+
+
+@dataclasses.dataclass(frozen=True)
+class Mutant:
+    name: str
+    category: str
+    change: str                 # what the edit does, for the table
+    claim: str                  # the perturbation and the test/tolerance that claims to catch it
+    edits: tuple                # (file, original text, replacement), applied in order
+
+
+def mutant(name, category, change, claim, *edits):
+    return Mutant(name, category, change, claim, tuple(edits))
+
+
+C, G1, MODEL, STATE = "fmu_src/contact.c", "fmu_src/g1.c", "fmu_src/fmu_model.c", "fmu_src/fmi2_cosim.c"
+SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
+STRUCTURAL = "structural (no tolerance involved)"
+
+MUTANTS = [
+    # ------------------------------------------------------------ force laws
+    mutant("hertz-exponent", "force laws", "implicit stage: F = K x1^(3/2 + 2e-12)",
+           "exponent +2e-12: F off by 2.2e-11 to 2.9e-11 at the driven test's x1 = 5e-7..2e-5 m; "
+           "DRIVEN_RTOL 1e-11 (test_fmu_physics::test_driven_hertz_law_is_k_x1_to_the_3_2)",
+           (C, "F = K * s * s * s;", "F = K * s * s * s * pow(s, 4e-12);")),
+    mutant("hertz-constant", "force laws", "k from the materials ×(1 + 3e-15)",
+           "3e-15; test_contact test_hertz_constant rel 1e-15",
+           (C, "return 4.0 / 3.0 * E_star * sqrt(R);", "return 4.0 / 3.0 * E_star * sqrt(R) * (1.0 + 3e-15);")),
+    mutant("g1-ratio-tgamma", "force laws", "G1 ratio Γ(N+3/2)/(Γ(N) N^(3/2)), N < 30 branch, ×(1 + 3e-14)",
+           "3e-14; test_g1 test_line_ratio rel 1e-14 against extended-precision lgamma",
+           (G1, "return tgamma(N + a) / (tgamma(N) * pow(N, a));",
+            "return tgamma(N + a) / (tgamma(N) * pow(N, a)) * (1.0 + 3e-14);")),
+    mutant("g1-ratio-stirling", "force laws", "G1 ratio, Stirling branch (N >= 30): exp(... - a (1 + 2e-14) ...)",
+           "ratio ×(1 - 3e-14); test_g1 test_line_ratio rel 1e-14 (N up to 5000)",
+           (G1, "return exp((N + a - 0.5) * log1p(a / N) - a\n",
+            "return exp((N + a - 0.5) * log1p(a / N) - a * (1.0 + 2e-14)\n")),
+    mutant("gamma-5-2", "force laws", "the constant Γ(5/2) ×(1 + 3e-14) (it scales the semi-integral)",
+           "3e-14; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms: "
+           "d semi_integral/dt = dF/dt / (Γ(5/2) k) rel 1e-14",
+           (C, "#define GAMMA_5_2 1.3293403881791355", "#define GAMMA_5_2 (1.3293403881791355 * (1.0 + 3e-14))")),
+    mutant("richardson-odd-N", "force laws", "extrapolated G1 ratio: M = ceil(N/2) instead of floor(N/2) for odd N > 1",
+           STRUCTURAL + "; the FMU's law 3 meets odd N at every other step since onset",
+           (G1, "double M = floor(0.5 * N);", "double M = N > 1.0 ? ceil(0.5 * N) : 0.0;")),
+    # ------------------------------------------------------ G1 weights and sums
+    mutant("g1-weight-w0", "G1 weights and sums", "w_0 = 1 + 2e-12 (every weight scaled)",
+           "2e-12; test_g1 test_line_identity rel 1e-12 (at N = 1 the sum is w_0 x)",
+           (G1, "w[0] = 1.0;", "w[0] = 1.0 + 2e-12;")),
+    mutant("g1-weight-recursion", "G1 weights and sums", "w_j = w_(j-1) (1 - (α + 1 + 2e-13)/j)",
+           "2e-13 in α + 1: the line's sum moves by 1.2e-12 (N = 1e3) to 2.6e-12 (N = 1e6); "
+           "test_g1 test_line_identity rel 1e-12",
+           (G1, "w[j] = w[j - 1] * (1.0 - (alpha + 1.0) / (double)j);",
+            "w[j] = w[j - 1] * (1.0 - (alpha + 1.0 + 2e-13) / (double)j);")),
+    mutant("g1-history-oldest", "G1 weights and sums", "history sum stops one term early (j < n instead of j <= n)",
+           STRUCTURAL + "; the oldest sample is 0 on the line, not in test_g1_grid's sine history (rel 1e-12)",
+           (G1, "for (j = 0; j <= n / stride; j++) {", "for (j = 0; j < n / stride; j++) {")),
+    mutant("g1-sum-compensation", "G1 weights and sums", "history sum without Neumaier's compensation",
+           "rounding only (~sqrt(N) ulp, 1e-13 at N = 1e6 says g1.c); test_g1 test_line_identity rel 1e-12",
+           (G1, "return sum + carry;", "return sum;")),
+    mutant("g1-delta-power", "G1 weights and sums", "history sum: Δ^(-α) with Δ ×(1 + 4e-12)",
+           "sum off by |α| 4e-12 >= 2e-12; test_g1 test_line_identity rel 1e-12",
+           (G1, "return pow(delta, -alpha) * weighted_history(w, f, n_samples - 1, 1);",
+            "return pow(delta * (1.0 + 4e-12), -alpha) * weighted_history(w, f, n_samples - 1, 1);")),
+    mutant("g1-extrapolated-coarse", "G1 weights and sums", "Richardson sum: the 2Δ grid's term ×(1 + 4e-13)",
+           "2e-13 absolute at α = -1 on the line (value 1/2); test_g1 test_extrapolated_order: error < 1e-13 there",
+           (G1, "- pow(2.0 * delta, -alpha) * weighted_history(w, f, n, 2);",
+            "- pow(2.0 * delta, -alpha) * (1.0 + 4e-13) * weighted_history(w, f, n, 2);")),
+    mutant("g1-N-off-by-one", "G1 weights and sums", "the G1 law counts N = steps since onset + 2 (not + 1)",
+           STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error, DRIVEN_RTOL 1e-11",
+           (C, "K = contact_spring_stiffness(cm, s->n + 1);", "K = contact_spring_stiffness(cm, s->n + 2);")),
+    # ------------------------------------------------------------ time scheme
+    mutant("sdirk-gamma", "time scheme", "SDIRK γ = (1 - 1/√2)(1 + 1e-4): first order",
+           "measured: per-impact figures off by 1.5e-7 from the GSL reference; "
+           "test_solver::test_per_impact_figures_against_the_reference rel 1e-7",
+           (C, "#define SDIRK_GAMMA 0.29289321881345248",
+            "#define SDIRK_GAMMA (0.29289321881345248 * (1.0 + 1e-4))")),
+    mutant("sdirk-impulse-weight", "time scheme", "the step's impulse h((1-γ)F1 + γ F2(1 + 1e-11)), which moves x2",
+           "x2 off by ~3e-12; momentum identity x2 = m v0 (1 + eps)/c rel 1e-12 (test_contact, "
+           "test_fmu_physics::test_drop_momentum_identity)",
+           (C, "impulse = hb * F1 + hg * F2;", "impulse = hb * F1 + hg * F2 * (1.0 + 1e-11);")),
+    mutant("sdirk-dissipation", "time scheme", "each step's dissipation J²/(c h) ×(1 + 2e-8)",
+           "2e-8; test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
+           "E_diss = m v0² (1 - eps²)/2 rel 1e-8",
+           (C, "impulse * impulse * inv_c / h : 0.0);", "impulse * impulse * inv_c / h * (1.0 + 2e-8) : 0.0);")),
+    mutant("step-count", "time scheme", "H = n dt_max takes n + 1 internal steps (ceil forgives no ulp)",
+           STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
+           "N = 10 steps per 1 us",
+           (C, "ceil(remaining / cm->p.dt_max * (1.0 - 1e-12))", "ceil(remaining / cm->p.dt_max * (1.0 + 1e-12))")),
+    # ----------------------------------------------------------------- events
+    mutant("onset-location", "events", "contact onset inside a free-flight step: time ×(1 + 3e-14)",
+           "3e-14; test_solver::test_free_flight_is_one_exact_step: t_onset, v_onset rel 1e-14",
+           (C, "return fmin(fmax(t, 0.0), h);", "return fmin(fmax(t * (1.0 + 3e-14), 0.0), h);")),
+    mutant("separation-location", "events", "separation located where x1 = -1e-10 m instead of 0",
+           "t_contact +2.1e-7 (1e-10 m at 0.36 m/s over 1.32 ms); "
+           "test_solver::test_per_impact_figures_against_the_reference rel 1e-7",
+           (C, "return s->x1;", "return s->x1 + 1e-10;"),
+           (C, "separates = !(trial.x1 > 0.0)", "separates = !(trial.x1 + 1e-10 > 0.0)"),
+           (C, "tau = event_time(cm, s, h, K, indentation, trial.x1, &trial);",
+            "tau = event_time(cm, s, h, K, indentation, trial.x1 + 1e-10, &trial);")),
+    mutant("peak-in-step", "events", "F_peak sampled at step ends only (the peak inside a step dropped)",
+           STRUCTURAL + "; ~(π h / t_c)²/8 ~ 7e-9 at dt 1e-7 (contact.c: more than the scheme's error)",
+           (C, "return at.F > end->F ? at.F : end->F;", "return end->F;")),
+    # ---------------------------------------------------------- proxy striker
+    mutant("proxy-gravity", "proxy striker", "the driven scene's proxy striker ignores g",
+           STRUCTURAL + "; test_readme::test_the_readme_master_loop_is_the_drop_test with g, bit-exact "
+           "drop vs driven (test_fmu_coupling)",
+           (C, "cm->accel = m > 0.0 ? cm->p.g : slope;", "cm->accel = m > 0.0 ? 0.0 : slope;")),
+    mutant("proxy-mass", "proxy striker", "the proxy striker's 1/m one ulp high",
+           "1 ulp; test_fmu_coupling::test_mass_aware_coupling_with_an_exact_master_is_the_drop_test: bit for bit",
+           (C, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
+    mutant("striker-velocity", "proxy striker", "striker FMU: v += H a (1 + 2e-12)",
+           "v off by 2.9e-13 after 100 steps; test_striker_fmu::test_motion_under_a_held_force_is_the_parabola "
+           "v rel 1e-13",
+           (STRIKER, "fm->v += H * a;", "fm->v += H * a * (1.0 + 2e-12);")),
+    # -------------------------------------------------------- gravity and gap
+    mutant("gravity-sign", "gravity and gap", "the drop test's gravity points away from the specimen",
+           STRUCTURAL + "; test_contact test_gap_and_gravity, test_solver free fall",
+           (C, "cm->accel = p->g;", "cm->accel = -p->g;")),
+    mutant("gravity-scale", "gravity and gap", "the drop test's g ×(1 + 5e-14)",
+           "t_onset, v_onset off by 2.5e-14; test_solver::test_free_flight_is_one_exact_step rel 1e-14",
+           (C, "cm->accel = p->g;", "cm->accel = p->g * (1.0 + 5e-14);")),
+    mutant("gap-ignored", "gravity and gap", "gap0 ignored: the striker starts on the specimen",
+           STRUCTURAL + "; test_contact test_gap_and_gravity onset time rel 1e-12",
+           (C, "cm->s.x1 = -p->gap0;", "cm->s.x1 = 0.0;")),
+    mutant("gap-scale", "gravity and gap", "gap0 ×(1 + 5e-14)",
+           "t_onset, v_onset off by 2.5e-14; test_solver::test_free_flight_is_one_exact_step rel 1e-14",
+           (C, "cm->s.x1 = -p->gap0;", "cm->s.x1 = -p->gap0 * (1.0 + 5e-14);")),
+    # ------------------------------------------------------- the state's CRC
+    mutant("crc-check-skipped", "state CRC", "a state's payload checksum is not checked",
+           STRUCTURAL + "; test_fmu_state::test_damaged_states_are_refused[corrupted]",
+           (STATE, "if (serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))",
+            "if (0 && serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))")),
+    mutant("crc-range-short", "state CRC", "the checksum (written and checked) leaves out the payload's last 8 bytes",
+           STRUCTURAL + "; a damaged last field would pass",
+           (STATE, "serial_put_u32(b + 16, serial_crc32(p, payload));",
+            "serial_put_u32(b + 16, serial_crc32(p, payload - 8));"),
+           (STATE, "serial_crc32(b + STATE_HEADER, payload))", "serial_crc32(b + STATE_HEADER, payload - 8))")),
+    mutant("crc-guid-unchecked", "state CRC", "a state's GUID checksum is not checked (another FMU's state)",
+           STRUCTURAL + "; test_fmu_state::test_damaged_states_are_refused[another FMU]",
+           (STATE, "if (serial_get_u32(b + 8) != serial_crc32(",
+            "if (0 && serial_get_u32(b + 8) != serial_crc32(")),
+    mutant("crc-polynomial", "state CRC", "CRC-32C's polynomial instead of CRC-32's (zlib's)",
+           STRUCTURAL + "; the state tests re-checksum with zlib.crc32",
+           ("fmu_src/serial.c", "0xEDB88320u", "0x82F63B78u")),
+    # ---------------------------------------------------------- output scaling
+    mutant("x2-output", "output scaling", "output x2 ×(1 + 2e-12)",
+           "2e-12; test_fmu_physics::test_drop_momentum_identity x2 rel 1e-12, "
+           "test_fmu_compliance x = x1 + x2 rel 1e-12",
+           (MODEL, "case VR_x2: return cm->s.x2;", "case VR_x2: return cm->s.x2 * (1.0 + 2e-12);")),
+    mutant("F_avg-length", "output scaling", "F_avg = impulse / (H (1 + 2e-12))",
+           "2e-12; test_fmu_coupling::test_F_avg_is_the_impulse_that_conserves_momentum rel 1e-12",
+           (MODEL, "fm->F_avg = impulse / H;", "fm->F_avg = impulse / (H * (1.0 + 2e-12));")),
+    mutant("semi-integral-output", "output scaling", "output semi_integral ×(1 + 2e-12)",
+           "2e-12; test_fmu_compliance::test_every_variable_is_read_or_written semi_integral rel 1e-12",
+           (MODEL, "case VR_semi_integral: return contact_semi_integral(cm);",
+            "case VR_semi_integral: return contact_semi_integral(cm) * (1.0 + 2e-12);")),
+    mutant("semi-integral-rate", "output scaling", "d semi_integral/dt ×(1 + 3e-14)",
+           "3e-14; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms rel 1e-14",
+           (MODEL, "*value = F_rate * contact_semi_integral_per_force(cm); break;",
+            "*value = F_rate * contact_semi_integral_per_force(cm) * (1.0 + 3e-14); break;")),
+    mutant("F-rate", "output scaling", "dF/dt = 1.5 (1 + 2e-11) K sqrt(x1) x1'",
+           "2e-11; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms "
+           "dF/dt rel 1e-11",
+           (C, "*F_rate = x1 > 0.0 ? 1.5 * contact_spring_stiffness",
+            "*F_rate = x1 > 0.0 ? 1.5 * (1.0 + 2e-11) * contact_spring_stiffness")),
+    mutant("eps-output", "output scaling", "restitution eps = -v_end/v_onset ×(1 + 3e-14)",
+           "3e-14; test_fmu_compliance::test_every_variable_is_read_or_written eps rel 1e-14",
+           (C, "s->eps = s->v_onset > 0.0 ? -v / s->v_onset : 0.0;",
+            "s->eps = s->v_onset > 0.0 ? -v / s->v_onset * (1.0 + 3e-14) : 0.0;")),
+    # ------------------------------------------------------------ serialization
+    mutant("state-drop-F_peak", "serialization", "F_peak left out of the FMU state",
+           STRUCTURAL + "; test_fmu_state restores into a new instance and compares every output bit for bit",
+           (MODEL, "F(model.s.F_peak), ", "")),
+    mutant("state-drop-v_onset", "serialization", "v_onset left out of the FMU state (eps after a restore)",
+           STRUCTURAL + "; test_fmu_state compares outputs bit for bit after a restore",
+           (MODEL, "F(model.s.v_onset), ", "")),
+    # ------------------------------------------------------------ call sequence
+    mutant("seq-set-after-terminate", "call sequence", "fmi2Set* allowed in the terminated state",
+           STRUCTURAL + "; test_fmi2 'after terminate'",
+           (STATE, "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE)",
+            "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)")),
+    mutant("seq-step-in-initialization", "call sequence", "fmi2DoStep allowed in initialization mode",
+           STRUCTURAL + "; test_fmi2, test_fmu_bad_input::test_wrong_call_order_is_an_error_not_a_crash",
+           (STATE, 'REQUIRE(STEP_COMPLETE, "fmi2DoStep");', 'REQUIRE(STEP_COMPLETE | INITIALIZATION_MODE, "fmi2DoStep");')),
+    # -------------------------------------------------- solver's per-impact figures
+    mutant("per-impact-E_diss", "solver per-impact", "each impact's E_diss counted from t = 0, not from its onset",
+           STRUCTURAL + "; test_solver::test_top_level_figures_say_which_impact_they_describe: "
+           "sum = total rel 1e-13",
+           (SOLVE, "done.E_diss = s->E_diss - E_diss_onset;", "done.E_diss = s->E_diss - 0.0 * E_diss_onset;")),
+    mutant("per-impact-v_onset", "solver per-impact", "each impact's v_onset ×(1 + 3e-14)",
+           "3e-14; test_solver::test_free_flight_is_one_exact_step v_onset rel 1e-14",
+           (SOLVE, "done.v_onset = s->v_onset;", "done.v_onset = s->v_onset * (1.0 + 3e-14);")),
+    mutant("per-impact-F_peak", "solver per-impact", "each impact's F_peak one ulp high",
+           "1 ulp; test_solver::test_top_level_figures_say_which_impact_they_describe: "
+           "F_peak = max of the impacts', exactly",
+           (SOLVE, "done.F_peak = s->F_peak_contact;", "done.F_peak = nextafter(s->F_peak_contact, INFINITY);")),
+]
+
+
+# --------------------------------------------------------------- the copy
+
+def source_files():
+    """The working tree's tracked and untracked (not ignored) files that exist."""
+    out = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
+                         capture_output=True, check=True).stdout.decode()
+    return sorted({f for f in out.split("\0") if f and (ROOT / f).is_file()})
+
+
+def check_mutants(mutants):
+    """Every edit's original text occurs exactly once in the working tree's
+    file (after the mutant's earlier edits): otherwise the source moved."""
+    problems = []
+    for m in mutants:
+        texts = {}
+        for path, old, new in m.edits:
+            text = texts.setdefault(path, (ROOT / path).read_text())
+            n = text.count(old)
+            if n != 1:
+                problems.append(f"{m.name}: {path}: the text {old!r} occurs {n} times (expected once): "
+                                "the source moved, rewrite the mutant")
+            else:
+                texts[path] = text.replace(old, new)
+    return problems
+
+
+def run(cmd, cwd, env=None, timeout=None):
+    """(returncode, output, seconds); returncode None after a timeout. The
+    command runs in its own process group, which a timeout kills whole."""
+    start = time.monotonic()
+    proc = subprocess.Popen([str(c) for c in cmd], cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, errors="replace", start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+        code = proc.returncode
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        code = None
+    return code, out, time.monotonic() - start
+
+
+class Copy:
+    """A copy of the sources with its own incremental build."""
+
+    def __init__(self, path, build_jobs):
+        self.src = pathlib.Path(path)
+        self.build = self.src / "build"
+        self.build_jobs = build_jobs
+        self.cmake = os.environ.get("CMAKE", "cmake")
+        self.ctest = str(pathlib.Path(shutil.which(self.cmake) or self.cmake).with_name("ctest"))
+
+    def sync(self, files):
+        """Makes the copy's sources equal to the working tree's; files are
+        written (new modification time) only where their bytes differ."""
+        wanted = set(files)
+        for rel in files:
+            data, dst = (ROOT / rel).read_bytes(), self.src / rel
+            if not dst.is_file() or dst.read_bytes() != data:
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                dst.write_bytes(data)
+            os.chmod(dst, stat.S_IMODE((ROOT / rel).stat().st_mode))
+        for path in list(self.src.rglob("*")):
+            rel = path.relative_to(self.src)
+            if rel.parts[0] == "build" or "__pycache__" in rel.parts or not path.is_file():
+                continue
+            if str(rel) not in wanted:
+                path.unlink()
+
+    def make(self):
+        """Configures (once) and builds; (ok, output)."""
+        if not (self.build / "CMakeCache.txt").exists():
+            code, out, _ = run([self.cmake, "-S", self.src, "-B", self.build, f"-DPython3_EXECUTABLE={PYTHON}"],
+                               self.src)
+            if code != 0:
+                return False, out
+        code, out, _ = run([self.cmake, "--build", self.build, "-j", self.build_jobs], self.src)
+        return code == 0, out
+
+    def apply(self, m):
+        """Applies the mutant's edits; returns the files' original texts."""
+        originals, texts = {}, {}
+        for path, old, new in m.edits:
+            if path not in texts:
+                texts[path] = originals[path] = (self.src / path).read_text()
+            if texts[path].count(old) != 1:
+                raise SystemExit(f"{m.name}: {path}: {old!r} does not occur exactly once in the copy")
+            texts[path] = texts[path].replace(old, new)
+        for path, text in texts.items():
+            (self.src / path).write_text(text)
+        return originals
+
+    def revert(self, originals):
+        for path, text in originals.items():
+            (self.src / path).write_text(text)  # a new modification time: the next build recompiles it
+
+    def c_tests(self, timeout, skip=(), stop=True):
+        """The C tests (every ctest test but pytest and those in skip),
+        stopping at the first failure: (failures, seconds), each failure
+        (test name, what failed), none when all pass."""
+        exclude = "^(" + "|".join(re.escape(t) for t in ("pytest", *skip)) + ")$"
+        code, out, seconds = run([self.ctest, "--test-dir", self.build, "-E", exclude, "--output-on-failure",
+                                  "--timeout", int(timeout), *(["--stop-on-failure"] if stop else [])], self.src,
+                                 timeout=timeout + 60)
+        if code == 0:
+            return [], seconds
+        if code is None:
+            return [("ctest", f"timed out after {seconds:.0f} s")], seconds
+        failed = re.findall(r"^\s*\d+ - (\S+) \(([^)]*)\)", out, re.M)
+        if not failed:
+            return [("ctest", shorten(out[-300:]))], seconds
+        check = re.search(r"^(?:\S*/)?([\w.]+\.c):(\d+): check failed: .*?: (.*)$", out, re.M)
+        first = f"{check.group(1)}:{check.group(2)}: {check.group(3)}" if check else failed[0][1]
+        return [(failed[0][0], shorten(first))] + [(name, why) for name, why in failed[1:]], seconds
+
+    def pytest_environment(self):
+        """The environment CMakeLists.txt gives ctest's pytest test (the
+        build's FMUs, solver, library...), read from ctest itself."""
+        shown = subprocess.run([self.ctest, "--test-dir", str(self.build), "--show-only=json-v1", "-R", "^pytest$"],
+                               cwd=self.src, capture_output=True, text=True, check=True).stdout
+        env = dict(os.environ)
+        for test in json.loads(shown)["tests"]:
+            for prop in test.get("properties", []):
+                if prop["name"] == "ENVIRONMENT":
+                    env.update(value.split("=", 1) for value in prop["value"])
+        # no bytecode in the copy; a wide terminal, so that the summary keeps each failure's message
+        env.update(PYTHONDONTWRITEBYTECODE="1", COLUMNS="400")
+        return env
+
+    def pytest(self, timeout, skip=(), stop=True):
+        """pytest over the copy's tests, slow files last, without the node ids
+        (or files) in skip, with -x when stop: (failures, seconds), each
+        failure (node id, why), none when all pass."""
+        tests = sorted(p.name for p in (self.src / "tests").glob("test_*.py") if f"tests/{p.name}" not in skip)
+        order = [t for t in tests if t not in SLOW_LAST] + [t for t in SLOW_LAST if t in tests]
+        env = self.pytest_environment()
+        # a file that fails to import is left out whole; without -x the others still run
+        skipping = [f"--deselect={n}" for n in skip if "::" in n]
+        code, out, seconds = run([PYTHON, "-m", "pytest", *(["-x"] if stop else ["--continue-on-collection-errors"]),
+                                  "-v", "-rfE",
+                                  "-p", "no:cacheprovider", *skipping, *(f"tests/{t}" for t in order)],
+                                 self.src, env=env, timeout=timeout)
+        if code == 0:
+            return [], seconds
+        started = re.findall(r"^(tests/\S+?::.*?)(?: (?:PASSED|FAILED|ERROR|SKIPPED|XFAIL|XPASS)\b.*)?$", out, re.M)
+        where = started[-1] if started else "?"
+        if code is None:
+            return [(where, f"timed out after {seconds:.0f} s")], seconds
+        failed = re.findall(r"^(?:FAILED|ERROR) (tests/.+?)(?: - (.*))?$", out, re.M)
+        if failed:
+            return [(node, shorten(why or "failed")) for node, why in failed], seconds
+        return [(where, f"pytest exited with {code}" + (f" (signal {-code})" if code < 0 else ""))], seconds
+
+
+def shorten(text, n=140):
+    text = " ".join(text.split())
+    return text if len(text) <= n else text[:n - 1] + "…"
+
+
+# ------------------------------------------------------------------- runs
+
+@dataclasses.dataclass
+class Result:
+    mutant: Mutant
+    verdict: str        # KILLED, SURVIVED, ERROR
+    by: str             # the first failing test and why, or what went wrong
+    seconds: float
+
+
+def run_mutant(copy, m, py_timeout, skip_c, skip_py):
+    start = time.monotonic()
+    originals = copy.apply(m)
+    try:
+        ok, out = copy.make()
+        if not ok:
+            errors = [line for line in out.splitlines() if "error" in line]
+            return Result(m, "ERROR", "build failed: " + shorten(errors[0] if errors else out[-300:]),
+                          time.monotonic() - start)
+        failed, _ = copy.c_tests(300, skip_c)
+        if not failed:
+            failed, _ = copy.pytest(py_timeout, skip_py)
+    finally:
+        copy.revert(originals)
+    by = f"{failed[0][0]}: {failed[0][1]}" if failed else ""
+    return Result(m, "KILLED" if failed else "SURVIVED", by, time.monotonic() - start)
+
+
+def baseline(copy):
+    """The unmutated copy must build; its C tests and pytest run whole.
+    Returns (C test names, pytest node ids that fail unmutated, C seconds,
+    pytest seconds): the mutants run without those, and the report says so
+    (work in progress in the working tree can fail on its own)."""
+    ok, out = copy.make()
+    if not ok:
+        raise SystemExit(f"the unmutated copy does not build:\n{out[-3000:]}")
+    c_failed, c_seconds = copy.c_tests(600, stop=False)
+    py_failed, py_seconds = copy.pytest(1800, stop=False)
+    return [n for n, _ in c_failed], [n for n, _ in py_failed], c_seconds, py_seconds
+
+
+def cell(text):
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def section(results, started, seconds, jobs, source, left_out):
+    killed = sum(r.verdict == "KILLED" for r in results)
+    survived = [r.mutant.name for r in results if r.verdict == "SURVIVED"]
+    errors = [r.mutant.name for r in results if r.verdict == "ERROR"]
+    lines = [BEGIN, "## Mutation testing", "",
+             "Regenerate: `scripts/report mutation` (this section only; `--list` shows the mutants, "
+             "`--only NAME...` re-runs some without writing here). `scripts/mutation.py` copies the working tree "
+             "(tracked and untracked files) to a scratch directory, applies each mutant there (each edit's original "
+             "text must occur exactly once in its file, or the run stops: the source moved), rebuilds, and runs the "
+             "C tests (ctest, stopping at the first failure) and then `pytest -x` (files in alphabetical order, "
+             f"{', '.join(SLOW_LAST)} last). The first failing test kills the mutant. A numeric mutant is perturbed "
+             "by two to three times the smallest error that the named test's stated tolerance claims to catch; "
+             "structural ones change what is computed.", "",
+             f"This run: {started:%Y-%m-%d %H:%M} UTC, {seconds / 60:.1f} min on this machine "
+             f"({os.cpu_count()} cores, shared; {jobs} mutant{'s' if jobs > 1 else ''} at a time), sources {source}. "
+             f"**{len(results)} mutants: {killed} killed, {len(survived)} survived"
+             + (f", {len(errors)} did not build" if errors else "") + "**"
+             + (f" (survivors: {', '.join(survived)})." if survived else "."), ""]
+    if left_out:
+        lines += ["Tests that failed on the unmutated sources (work in progress in the working tree) and were "
+                  "therefore left out of the mutant runs: " + ", ".join(f"`{n}`" for n in left_out) + ".", ""]
+    lines += ["| mutant | category | change | perturbation: the tolerance that claims it | verdict | first failing test |",
+              "|---|---|---|---|---|---|"]
+    for r in results:
+        files = ", ".join(dict.fromkeys(pathlib.Path(e[0]).name for e in r.mutant.edits))
+        lines.append(f"| `{r.mutant.name}` | {r.mutant.category} | {cell(files)}: {cell(r.mutant.change)} | "
+                     f"{cell(r.mutant.claim)} | **{r.verdict}** | {cell(r.by) or '—'} |")
+    lines += ["", END]
+    return "\n".join(lines) + "\n"
+
+
+def write_section(text):
+    """Replaces the marked section of docs/reliability.md, or appends it."""
+    old = DOC.read_text() if DOC.exists() else "# Reliability\n"
+    start, end = old.find(BEGIN), old.find(END)
+    if start >= 0 and end > start:
+        new = old[:start] + text + old[end + len(END):].lstrip("\n")
+    else:
+        new = old.rstrip("\n") + "\n\n" + text
+    atomic.write_text(DOC, new)
+
+
+def source_description():
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=normal"], cwd=ROOT,
+                           capture_output=True, text=True).stdout.strip()
+    return f"`{head.strip()}`" + (" with uncommitted changes" if dirty else "")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--list", action="store_true", help="list the mutants (checked against the sources) and stop")
+    parser.add_argument("--only", nargs="+", metavar="NAME", help="run these mutants only; docs are left alone")
+    parser.add_argument("--jobs", type=int, default=1, help="mutants at a time, each in its own copy (default 1)")
+    parser.add_argument("--workdir", type=pathlib.Path,
+                        default=pathlib.Path(tempfile.gettempdir()) / f"fraccontact-mutation-{os.getuid()}",
+                        help="where the copies live, kept between runs for incremental builds")
+    parser.add_argument("--no-baseline", action="store_true", help="skip the unmutated run (faster, less safe)")
+    parser.add_argument("--strict-baseline", action="store_true",
+                        help="stop when a test fails unmutated (default: leave it out of the mutant runs, and say so)")
+    args = parser.parse_args()
+
+    names = [m.name for m in MUTANTS]
+    assert len(set(names)) == len(names), "duplicate mutant names"
+    mutants = MUTANTS
+    if args.only:
+        unknown = [n for n in args.only if n not in names]
+        if unknown:
+            raise SystemExit(f"unknown mutants: {', '.join(unknown)} (see --list)")
+        mutants = [m for m in MUTANTS if m.name in args.only]
+    problems = check_mutants(mutants)
+    if problems:
+        raise SystemExit("\n".join(problems))
+    if args.list:
+        for m in mutants:
+            print(f"{m.name:28} {m.category:20} {m.change}\n{'':49} claim: {m.claim}")
+        print(f"{len(mutants)} mutants, every edit found once in the sources")
+        return 0
+
+    started, t0 = datetime.datetime.now(datetime.timezone.utc), time.monotonic()
+    source = source_description()
+    files = source_files()
+    jobs = max(1, min(args.jobs, len(mutants)))
+    build_jobs = max(1, (os.cpu_count() or 1) // jobs)
+    copies = [Copy(args.workdir / f"src-{i}", build_jobs) for i in range(jobs)]
+    for c in copies:
+        c.sync(files)
+    py_timeout, skip_c, skip_py = 1800, [], []
+    if not args.no_baseline:
+        print("baseline: the unmutated copy, every test ...", flush=True)
+        skip_c, skip_py, c_seconds, py_seconds = baseline(copies[0])
+        py_timeout = max(300, 3 * py_seconds)
+        print(f"baseline: C tests {c_seconds:.0f} s, pytest {py_seconds:.0f} s; "
+              f"a mutant's pytest times out after {py_timeout:.0f} s", flush=True)
+        for name in skip_c + skip_py:
+            print(f"baseline: FAILS UNMUTATED, left out of the mutant runs: {name}", flush=True)
+        if (skip_c or skip_py) and args.strict_baseline:
+            raise SystemExit("the unmutated copy fails (--strict-baseline)")
+
+    results = [None] * len(mutants)
+    free = list(copies)
+    lock = threading.Lock()
+    done = 0
+
+    def work(i):
+        nonlocal done
+        with lock:
+            copy = free.pop()
+        try:
+            r = run_mutant(copy, mutants[i], py_timeout, skip_c, skip_py)
+        finally:
+            with lock:
+                free.append(copy)
+        with lock:
+            results[i] = r
+            done += 1
+            print(f"[{done:2}/{len(mutants)}] {r.mutant.name:28} {r.verdict:8} {r.seconds:5.0f} s  {r.by}", flush=True)
+
+    with concurrent.futures.ThreadPoolExecutor(jobs) as pool:
+        for f in [pool.submit(work, i) for i in range(len(mutants))]:
+            f.result()
+
+    seconds = time.monotonic() - t0
+    survived = [r.mutant.name for r in results if r.verdict != "KILLED"]
+    print(f"{len(results)} mutants in {seconds / 60:.1f} min: {len(results) - len(survived)} killed"
+          + (f"; not killed: {', '.join(survived)}" if survived else ""))
+    if args.only:
+        print("(--only: docs/reliability.md left as it was)")
+    else:
+        write_section(section(results, started, seconds, jobs, source, skip_c + skip_py))
+        print(f"wrote the table to {DOC.relative_to(ROOT)}")
+    return 1 if survived else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
