@@ -77,6 +77,7 @@ static void test_call_sequence(void)
     expect_error(fmi2Terminate(c), "fmi2Terminate", NULL, "terminate before init");
     CHECK(fmi2EnterInitializationMode(c) == fmi2OK, "enter");
     expect_error(fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), "fmi2SetupExperiment", NULL, "setup late");
+    expect_error(fmi2DoStep(c, 0.0, 1e-5, fmi2True), "fmi2DoStep", "illegal call sequence", "doStep in initialization");
     CHECK(fmi2ExitInitializationMode(c) == fmi2OK, "exit");
     expect_error(fmi2EnterInitializationMode(c), "fmi2EnterInitializationMode", NULL, "enter twice");
     CHECK(fmi2DoStep(c, 0.0, 1e-5, fmi2True) == fmi2OK, "a step");
