@@ -4,8 +4,7 @@
  * a long soak would overflow. A wrong width is a compile error here. */
 #include "contact.h"
 
-#define SIXTY_FOUR_BITS(field) typedef char field##_is_64_bits[sizeof(((contact_state *)0)->field) == 8 ? 1 : -1]
+#define SIXTY_FOUR_BITS(field) typedef char field##_is_64_bits[sizeof(((contact_state *)0)->field) == 8 ? 1 : -1];
+#define ANY_WIDTH(field)
 
-SIXTY_FOUR_BITS(n);
-SIXTY_FOUR_BITS(steps);
-SIXTY_FOUR_BITS(impacts);
+CONTACT_STATE_FIELDS(ANY_WIDTH, SIXTY_FOUR_BITS, ANY_WIDTH)

@@ -1,6 +1,7 @@
 /* FMI 2.0 co-simulation glue: instances, the call-sequence state machine,
- * logging, and the translation of FMI calls onto a model (fmu_interface.h). It knows the
- * standard, not the physics. */
+ * logging, communication times, the FMU state, and the translation of FMI
+ * calls onto a model (fmu_interface.h). It knows the standard, not the
+ * physics; the FMU it serves names itself in guid.h. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -134,7 +135,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     memset(&probe, 0, sizeof probe);
     probe.callbacks = *functions;
-    probe.name = (char *)(instanceName ? instanceName : "fraccontact");
+    probe.name = (char *)(instanceName ? instanceName : FMU_MODEL_IDENTIFIER);
     if (!instanceName || !*instanceName) {
         fail(&probe, "fmi2Instantiate: instanceName must be a non-empty string");
         return NULL;
@@ -351,9 +352,26 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     instance *in = c;
+    const double t = currentCommunicationPoint, H = communicationStepSize;
+    double now;
+    char message[200];
     (void)noSetFMUStatePriorToCurrentPoint;
     REQUIRE(STEP_COMPLETE, "fmi2DoStep");
-    return fm_do_step(in->fm, currentCommunicationPoint, communicationStepSize) == FM_OK ? fmi2OK : fmi2Error;
+    if (!isfinite(t) || !isfinite(H) || H < 0.0) {
+        snprintf(message, sizeof message,
+                 "fmi2DoStep: currentCommunicationPoint = %.17g, communicationStepSize = %.17g: "
+                 "both must be finite and the step size >= 0", t, H);
+        return fail(in, message);
+    }
+    /* Masters accumulate time with rounding: a mismatch below a millionth
+     * of the step is theirs, and the model takes their time. */
+    now = fm_time(in->fm);
+    if (fabs(t - now) > 1e-6 * H + 1e-12 * fabs(t)) {
+        snprintf(message, sizeof message,
+                 "fmi2DoStep: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", t, now);
+        return fail(in, message);
+    }
+    return fm_do_step(in->fm, t, H) == FM_OK ? fmi2OK : fmi2Error;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)
@@ -460,7 +478,7 @@ static const char *state_problem(const unsigned char *b, size_t size)
 {
     size_t payload = state_size() - STATE_HEADER;
     if (size < STATE_HEADER || memcmp(b, STATE_MAGIC, 4) != 0)
-        return "not a fraccontact FMU state";
+        return "not a " FMU_MODEL_IDENTIFIER " FMU state";
     if (serial_get_u32(b + 4) != STATE_FORMAT)
         return "an FMU state of another format version";
     if (serial_get_u32(b + 8) != serial_crc32((const unsigned char *)FMU_GUID, strlen(FMU_GUID)))

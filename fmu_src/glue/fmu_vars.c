@@ -1,5 +1,6 @@
 #include "fmu_vars.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -90,4 +91,13 @@ void fmu_fields_read(void *base, const state_field *fields, size_t n, const unsi
             *(int64_t *)at = (int64_t)serial_get_u64(bytes);
         bytes += field_size(fields[i].kind);
     }
+}
+
+int fmu_fields_finite(const void *base, const state_field *fields, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (fields[i].kind == FIELD_F64 && !isfinite(*(const double *)((const char *)base + fields[i].offset)))
+            return 0;
+    return 1;
 }

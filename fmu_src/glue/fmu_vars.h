@@ -56,4 +56,8 @@ size_t fmu_fields_size(const state_field *fields, size_t n);
 void fmu_fields_write(const void *base, const state_field *fields, size_t n, unsigned char *bytes);
 void fmu_fields_read(void *base, const state_field *fields, size_t n, const unsigned char *bytes);
 
+/* Whether every double among the fields is finite: a state read from bytes
+ * may hold anything. */
+int fmu_fields_finite(const void *base, const state_field *fields, size_t n);
+
 #endif

@@ -537,11 +537,13 @@ static int internal_step(contact_model *cm, double h, double *impulse, unsigned 
     return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
-int contact_state_is_finite(const contact_state *s)
+static int state_is_finite(const contact_state *s)
 {
-    return isfinite(s->t) && isfinite(s->x1) && isfinite(s->x2) && isfinite(s->v) && isfinite(s->F)
-           && isfinite(s->E_diss) && isfinite(s->F_peak) && isfinite(s->F_peak_contact) && isfinite(s->eps) && isfinite(s->v_onset)
-           && isfinite(s->t_onset) && isfinite(s->t_contact) && isfinite(s->x_prev) && isfinite(s->h_prev);
+#define FINITE(field) && isfinite(s->field)
+#define ALWAYS_FINITE(field)
+    return 1 CONTACT_STATE_FIELDS(FINITE, ALWAYS_FINITE, ALWAYS_FINITE);
+#undef FINITE
+#undef ALWAYS_FINITE
 }
 
 double contact_advance(contact_model *cm, double H)
@@ -585,7 +587,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
     }
     /* A non-finite value stays non-finite through the steps that follow
      * (and bounds their event searches), so one check at the end suffices. */
-    if (!contact_state_is_finite(&cm->s)) {
+    if (!state_is_finite(&cm->s)) {
         cm->s = start;
         return NAN;
     }

@@ -66,6 +66,15 @@ typedef struct {
     int in_contact;
 } contact_state;
 
+/* Every field of contact_state, described once: DOUBLE(name) for the doubles,
+ * INT64(name) for the counters, INT(name) for the flag. The model's check that
+ * a step kept the state finite and whoever saves a state field by field
+ * expand it, so that a new field reaches both or neither. */
+#define CONTACT_STATE_FIELDS(DOUBLE, INT64, INT)                                                          \
+    DOUBLE(t) DOUBLE(x1) DOUBLE(x2) DOUBLE(v) DOUBLE(F) DOUBLE(F_peak) DOUBLE(F_peak_contact) DOUBLE(E_diss) \
+    DOUBLE(eps) DOUBLE(v_onset) DOUBLE(t_onset) DOUBLE(t_contact) DOUBLE(x_prev) DOUBLE(h_prev)            \
+    INT64(n) INT64(steps) INT64(impacts) INT(in_contact)
+
 typedef struct {
     contact_params p;
     double k;         /* the Hertz constant in use (given, or derived) */
@@ -135,9 +144,6 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at);
  * the specimen again (it moves away, or rests, and nothing accelerates it
  * back): nothing changes from then on. */
 int contact_never_returns(const contact_model *cm);
-
-/* Whether every value of the state is finite. */
-int contact_state_is_finite(const contact_state *s);
 
 /* Outputs derived from the state. */
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */

@@ -1,7 +1,7 @@
 /* What the FMI glue (fmi2_cosim.c) asks of a model: the hook interface each
- * FMU of this project implements (fmu_model.c for the contact element,
- * striker/striker_model.c for the striker). No FMI types: plain C values and
- * statuses numerically equal to the FMI ones. */
+ * FMU's binding implements (fmu_src/binding/fmu_model.c for the contact
+ * element, striker/striker_model.c for the striker). No FMI types: plain C
+ * values and statuses numerically equal to the FMI ones. */
 #ifndef FRACCONTACT_FMU_INTERFACE_H
 #define FRACCONTACT_FMU_INTERFACE_H
 
@@ -38,7 +38,9 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
  * FM_WARNING: started, with a reported warning (a value without effect). */
 fm_status fm_start(fmu_model *fm, double t0);
 
-/* One communication step [t, t + H], and the model's time. */
+/* One communication step [t, t + H], and the model's time. The glue has
+ * checked that H is finite and >= 0 and that t is the model's time up to
+ * the master's rounding: the model takes t as its time. */
 fm_status fm_do_step(fmu_model *fm, double t, double H);
 double fm_time(const fmu_model *fm);
 
