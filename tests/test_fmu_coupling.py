@@ -82,10 +82,9 @@ def test_output_derivatives_in_the_driven_scene_are_the_closed_forms(slave):
         # x1' = v - F/c with F/c ~ 1e-19, below half an ulp of v: exact
         assert d["x"] == v and d["x1"] == pytest.approx(v, rel=EPS, abs=0)
         assert d["x2"] == pytest.approx(K * (v * t) ** 1.5 / RIGID, rel=2e-14, abs=0)
-        # semi_integral' = F'/(Gamma(5/2) K): the C code's Gamma(5/2),
-        # 1.3293403881791355, is 1.1e-15 below the true 1.32934038817913702
-        # (measured 1.3e-15 here), and a few ulp of rounding: 4e-15.
-        assert d["semi_integral"] == pytest.approx(d["F"] / (GAMMA_5_2 * K), rel=4e-15, abs=0)
+        # semi_integral' = F'/(Gamma(5/2) K), both Gamma(5/2) the double
+        # nearest the true one: a few ulp of rounding, 1e-15.
+        assert d["semi_integral"] == pytest.approx(d["F"] / (GAMMA_5_2 * K), rel=1e-15, abs=0)
 
 
 def test_output_derivatives_in_the_drop_test_match_finite_differences(slave):

@@ -8,7 +8,7 @@
 #include "g1.h"
 
 /* Gamma(5/2) = 3 sqrt(pi) / 4: x1^(3/2) = Gamma(5/2) D^(-1/2) x1 (MODEL.md §3). */
-#define GAMMA_5_2 1.3293403881791355
+#define GAMMA_5_2 1.329340388179137
 
 /* Alexander's two-stage SDIRK: L-stable, second order, stiffly accurate.
  * L-stability keeps the step stable however fast the dashpot relaxes, and
