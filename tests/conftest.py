@@ -3,15 +3,13 @@
 import os
 import pathlib
 import shutil
-import sys
 
 import pytest
 from fmpy import extract, read_model_description
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "scripts"))  # scipy_contact: the second implementation of the ODE
+from fmu_driver import Slave
 
-from fmu_driver import Slave  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 FMU = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
 
 

@@ -1,8 +1,7 @@
 """Results are written whole or not at all: the reports' helper
-(scripts/atomic.py) and the solver's CSV, killed in the middle of writing,
+(fraccontact/atomic.py) and the solver's CSV, killed in the middle of writing,
 leave neither a temporary file nor a half-written result."""
 
-import os
 import signal
 import subprocess
 import sys
@@ -10,10 +9,8 @@ import time
 
 import pytest
 
-import atomic
+from fraccontact import atomic
 from test_solver import SOLVE
-
-SCRIPTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts")
 
 
 def test_an_interrupted_write_leaves_nothing(tmp_path):
@@ -47,9 +44,8 @@ def leftovers(directory, target, complete):
 # kills it while it waits, inside the write, without sleeping or racing.
 WRITER = r'''
 import sys
-sys.path.insert(0, sys.argv[1])
-import atomic
-target, how = sys.argv[2], sys.argv[3]
+from fraccontact import atomic
+target, how = sys.argv[1], sys.argv[2]
 with (atomic.replacing(target) if how == "atomic" else open(target, "w")) as f:
     f.write("row\n" * 100000)
     f.flush()
@@ -61,7 +57,7 @@ with (atomic.replacing(target) if how == "atomic" else open(target, "w")) as f:
 
 def kill_writer_inside_its_write(tmp_path, how):
     target = tmp_path / "report.txt"
-    writer = subprocess.Popen([sys.executable, "-c", WRITER, SCRIPTS, str(target), how], stdin=subprocess.PIPE,
+    writer = subprocess.Popen([sys.executable, "-c", WRITER, str(target), how], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, text=True)
     assert writer.stdout.readline() == "written\n"      # the first part is on disk
     writer.send_signal(signal.SIGTERM)

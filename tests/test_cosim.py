@@ -1,4 +1,4 @@
-"""The two-FMU co-simulation (scripts/cosim.py) against the monolithic drop
+"""The two-FMU co-simulation (fraccontact/cosim.py) against the monolithic drop
 test, and the same scene in libcosim, an independent FMI 2.0 importer."""
 
 import os
@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from cosim import cosimulate, cosimulate_libcosim, monolithic
+from fraccontact.cosim import cosimulate, cosimulate_libcosim, monolithic
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
@@ -62,9 +62,8 @@ def test_libcosim_runs_the_scene_as_our_jacobi_master_does(coupling):
 # tempfile.mkdtemp() ("tmp" + 8 characters in the temp dir), so counting them
 # there sees only this driver's, not those of tests running alongside.
 COUNT_EXTRACTIONS = """
-import pathlib, sys, tempfile
-sys.path.insert(0, {scripts!r})
-from cosim import cosimulate, monolithic
+import pathlib, tempfile
+from fraccontact.cosim import cosimulate, monolithic
 folders = lambda: len(list(pathlib.Path(tempfile.gettempdir()).glob("tmp*")))
 for H in (1e-4, 2e-4, 5e-4):
     cosimulate({contact!r}, {striker!r}, H, "mass-aware", "gauss-seidel")
@@ -76,7 +75,7 @@ for H in (1e-4, 2e-4, 5e-4):
 def test_each_fmu_is_extracted_once_and_removed_at_exit(tmp_path):
     """Issue 10, item 15: one folder per FMU file while the process runs
     (not one per instance: hundreds per study), none left after it."""
-    code = COUNT_EXTRACTIONS.format(scripts=str(ROOT / "scripts"), contact=str(CONTACT), striker=str(STRIKER))
+    code = COUNT_EXTRACTIONS.format(contact=str(CONTACT), striker=str(STRIKER))
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=dict(os.environ, TMPDIR=str(tmp_path)), timeout=300)
     assert run.returncode == 0, run.stderr

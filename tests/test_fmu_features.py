@@ -6,7 +6,7 @@ law (law 3) at odd N, the force peak located inside a coarse step, the
 
 The references: closed forms (MODEL.md §2, §4; free fall), GSL's
 high-accuracy solve of the same ODE (`fraccontact-solve --reference`) and
-scipy (scripts/scipy_contact.py). Every approximate comparison states its
+scipy (fraccontact/scipy_contact.py). Every approximate comparison states its
 absolute tolerance (usually 0) and where its relative one comes from."""
 
 import json
@@ -19,7 +19,7 @@ import subprocess
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from scipy_contact import solve_drop
+from fraccontact.scipy_contact import solve_drop
 
 from closed_forms import EPS, GAMMA_5_2, HERTZ_TC, SCHEME_RTOL, extrapolated_ratio, hertz_k
 from fmu_driver import C, K, M, V0

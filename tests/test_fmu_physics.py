@@ -11,13 +11,14 @@ import math
 import numpy as np
 import pytest
 from scipy.integrate import quad
-from scipy_contact import solve_drop
+
+from fraccontact.scipy_contact import solve_drop
 
 from closed_forms import EPS, GAMMA_5_2, HERTZ_TC, SCHEME_RTOL, g1_line_ratio, hertz_k
 from fmu_driver import C, K, M, run_impact
 
 def reference_drop(k, c, m, v0, method="DOP853", rtol=1e-13):
-    """The drop test's ODE by scipy (scripts/scipy_contact.py), independent
+    """The drop test's ODE by scipy (fraccontact/scipy_contact.py), independent
     of the C code: F_peak, eps, t_contact, x2, E_diss of the first impact."""
     r = solve_drop(k, c, m, v0, method=method, rtol=rtol)
     return {key: r[key] for key in ("F_peak", "eps", "t_contact", "x2", "E_diss")}

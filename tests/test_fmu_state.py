@@ -2,7 +2,6 @@
 for bit, in the same instance, in a new one and in another process; damaged,
 truncated or foreign states are refused with an error."""
 
-import os
 import struct
 import subprocess
 import sys
@@ -64,10 +63,9 @@ def test_a_serialized_state_survives_a_file_and_another_process(slave, fmu_path,
     path.write_bytes(s.fmu.serializeFMUstate(s.fmu.getFMUstate()))
     expected = run(s, 50)
     script = textwrap.dedent(f"""
-        import struct, sys
-        sys.path.insert(0, {os.path.dirname(__file__)!r})
+        import struct
         from fmpy import extract, read_model_description
-        from fmu_driver import Slave
+        from fraccontact.fmu import Slave
         md = read_model_description({str(fmu_path)!r})
         s = Slave(md, extract({str(fmu_path)!r}, unzipdir={str(tmp_path / "unzipped")!r}))
         s.fmu.setFMUstate(s.fmu.deSerializeFMUstate(open({str(path)!r}, "rb").read()))

@@ -9,7 +9,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 from fmpy import read_model_description
-from scipy_contact import solve_drop
+from fraccontact.scipy_contact import solve_drop
 
 import fraccontact
 from closed_forms import HERTZ_TC, SCHEME_RTOL, hertz_k

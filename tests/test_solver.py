@@ -11,7 +11,7 @@ import subprocess
 import pytest
 
 from fmu_driver import C, K, M, run_impact
-from scipy_contact import solve_drop
+from fraccontact.scipy_contact import solve_drop
 from test_fmu_physics import reference_drop
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent

@@ -1,31 +1,31 @@
-"""scripts/sweep.py on a local Dask cluster with a small grid: every impact
-is the solver's own result, in case order; any solver option can be varied or
-set, by its name with dashes or underscores; a Monte Carlo campaign is
-reproducible from its seed, scatters log-normally with the stated mean and
-coefficient of variation, and reports statistics that numpy computes alike
-from the CSV; bad sweeps are refused."""
+"""fraccontact sweep (fraccontact/sweep.py) on a local Dask cluster with a
+small grid: every impact is the library's own result, in case order; any
+parameter of the library can be varied or set, by its name with dashes or
+underscores; a case the library refuses is a row with its message; a Monte
+Carlo campaign is reproducible from its seed, scatters log-normally with the
+stated mean and coefficient of variation, and reports statistics that numpy
+computes alike from the CSV; bad sweeps are refused."""
 
 import csv
 import json
 import math
 import os
-import pathlib
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-import sweep
+import fraccontact
+from fraccontact import sweep
 
 # Dask's worker processes do not survive the sanitizer runtime preloaded into
-# Python (the sanitized build's pytest); the solver they run is tested there
-# directly (test_solver.py), so the sweep machinery runs in the normal build.
+# Python (the sanitized build's pytest); the library they run is tested there
+# directly (test_package.py), so the sweep machinery runs in the normal build.
 pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
                                 reason="Dask workers under a preloaded sanitizer runtime")
 
-SWEEP = pathlib.Path(sweep.__file__)
-# The paper's h20 constants, the solver's defaults (its --help).
+# The paper's h20 constants, the library's defaults.
 K, C = 3.299e8, 6080.0
 
 
@@ -34,11 +34,15 @@ def read(path):
         return list(csv.DictReader(f))
 
 
-def solve(*options, solver=None):
-    """One direct run of the solver: its JSON object."""
-    done = subprocess.run([str(solver or sweep.SOLVER), "--json", "--quiet", *options], capture_output=True, text=True,
-                          check=True)
-    return json.loads(done.stdout)
+def sweep_command(*args):
+    """The command line as a user types it: python -m fraccontact sweep ..."""
+    return subprocess.run([sys.executable, "-m", "fraccontact", "sweep", *args], capture_output=True, text=True)
+
+
+def one_by_one(**params):
+    """One run of the library (fraccontact.impact), its results as the sweep names them."""
+    r = fraccontact.impact(**params)
+    return {key: getattr(r, key) for key in sweep.RESULTS}
 
 
 def number(text):
@@ -49,15 +53,14 @@ def number(text):
         return None
 
 
-def assert_row_is_the_solver_result(row, direct, inputs):
-    """Every scalar number of the solver's JSON is in the row (as NAME_result
-    when NAME is an input column), to the last bit but for printing: the CSV
-    holds Python's shortest round-trip repr, and the same binary with the
-    same inputs is deterministic, so 1e-12 is only a guard against a value
-    passing through a shorter format."""
+def assert_row_is_the_library_result(row, direct, inputs):
+    """Every result is in the row (as NAME_result when NAME is an input
+    column), to the last bit but for printing: the CSV holds Python's
+    shortest round-trip repr, and a batch call computes each case as a run
+    of its own does (test_package.py), so 1e-12 is only a guard against a
+    value passing through a shorter format."""
+    assert set(row) == set(inputs) | {f"{key}_result" if key in inputs else key for key in direct}, row
     for key, value in direct.items():
-        if key == "cpu_seconds" or not isinstance(value, (int, float)) or isinstance(value, bool):
-            continue
         column = f"{key}_result" if key in inputs else key
         assert float(row[column]) == pytest.approx(value, rel=1e-12, abs=0), key
 
@@ -70,61 +73,53 @@ def grid(tmp_path_factory):
     return out
 
 
-def test_grid_results_are_the_solver_results_in_order(grid):
+def test_grid_results_are_the_library_results_in_order(grid):
     rows = read(grid / "sweep.csv")
     assert [(float(r["height"]), float(r["c"])) for r in rows] == [
         (h, c) for h in (0.01, 0.02, 0.03) for c in (3000.0, 6080.0)]
     for r in rows:
-        # No --law: the sweep's default law is the solver's own (g1).
-        assert_row_is_the_solver_result(r, solve("--height", r["height"], "--c", r["c"]), ("height", "c"))
+        # No --set law: the sweep's default law is the library's own (g1).
+        assert_row_is_the_library_result(r, one_by_one(height=float(r["height"]), c=float(r["c"])), ("height", "c"))
     summary = json.loads((grid / "sweep.json").read_text())
     assert summary["impacts"] == 6 and summary["failed"] == 0 and summary["impacts_per_second"] > 0
     assert (grid / "sweep.png").stat().st_size > 10000
 
 
 def test_help_states_the_default_law_and_the_scatter():
-    done = subprocess.run([sys.executable, str(SWEEP), "--help"], capture_output=True, text=True, check=True)
+    done = sweep_command("--help")
+    assert done.returncode == 0, done.stderr
     text = " ".join(done.stdout.split())
     assert "default law: g1" in text
     assert "coefficient of variation" in text and "log-normal" in text
 
 
-def test_any_solver_option_by_either_name(tmp_path):
-    """Issue 10, item 12: t-end, law and impacts were refused; E_s, t_end are
-    the FMU-style spellings of --E-s, --t-end; reference is a flag."""
-    assert sweep.main(["--vary", "law=hertz,g1x", "--vary", "impacts=1,3", "--vary", "t_end=0.05,0.3",
-                       "--vary", "reference=false,true", "--set", "g=9.81", "--set", "E_s=2e9", "--set", "k=0",
-                       "--workers", "2", "--batch", "3", "--out", str(tmp_path)]) == 0
+def test_any_parameter_by_either_name(tmp_path):
+    """Issue 10, item 12: t-end, law and impacts were refused; the library's
+    names (E_s, t_end) and the command line's spelling (E-s, t-end) alike;
+    the columns carry the library's names."""
+    assert sweep.main(["--vary", "law=hertz,g1x", "--vary", "impacts=1,3", "--vary", "t-end=0.05,0.3",
+                       "--set", "g=9.81", "--set", "E-s=2e9", "--set", "k=0", "--workers", "2", "--batch", "3",
+                       "--out", str(tmp_path)]) == 0
     rows = read(tmp_path / "sweep.csv")
-    assert len(rows) == 16 and list(rows[0])[:4] == ["law", "impacts", "t-end", "reference"]
+    assert len(rows) == 8 and list(rows[0])[:3] == ["law", "impacts", "t_end"]
     for r in rows:
-        direct = solve("--law", r["law"], "--impacts", r["impacts"], "--t-end", r["t-end"], "--g", "9.81",
-                       "--E-s", "2e9", "--k", "0", *(["--reference"] if r["reference"] == "True" else []))
-        assert_row_is_the_solver_result(r, direct, ("law", "impacts", "t-end", "reference"))
+        direct = one_by_one(law=r["law"], impacts=int(r["impacts"]), t_end=float(r["t_end"]), g=9.81, E_s=2e9, k=0.0)
+        assert_row_is_the_library_result(r, direct, ("law", "impacts", "t_end"))
 
 
-def test_results_skip_what_is_no_scalar_number(tmp_path):
-    """A solver whose JSON gains a list of objects and a string (per_impact,
-    stopped): the CSV keeps the scalar numbers and drops those two."""
-    wrapper = tmp_path / "solver"
-    wrapper.write_text(f"""#!{sys.executable}
-import json, subprocess, sys
-done = subprocess.run([{str(sweep.SOLVER)!r}] + sys.argv[1:], capture_output=True, text=True)
-if done.returncode == 0 and "--json" in sys.argv:
-    r = json.loads(done.stdout)
-    done.stdout = json.dumps(dict(r, per_impact=[dict(F_peak=r["F_peak"], eps=r["eps"])], stopped="impacts"))
-sys.stdout.write(done.stdout)
-sys.stderr.write(done.stderr)
-sys.exit(done.returncode)
-""")
-    wrapper.chmod(0o755)
-    assert "per_impact" in solve(solver=wrapper)
-    assert sweep.main(["--vary", "m=0.5,1", "--solver", str(wrapper), "--workers", "1",
-                       "--out", str(tmp_path / "out")]) == 0
-    rows = read(tmp_path / "out" / "sweep.csv")
-    assert "per_impact" not in rows[0] and "stopped" not in rows[0]
-    for r in rows:
-        assert_row_is_the_solver_result(r, solve("--m", r["m"]), ("m",))
+def test_a_refused_case_is_a_row_with_the_library_message(tmp_path, capsys):
+    """A chunk holding a case the library refuses runs its cases one by one:
+    the others keep their results, the refused one gets the library's
+    message, and the sweep exits 1."""
+    assert sweep.main(["--vary", "c=3000,-1,6080", "--set", "law=hertz", "--workers", "1",
+                       "--out", str(tmp_path)]) == 1
+    rows = read(tmp_path / "sweep.csv")
+    assert [r["c"] for r in rows] == ["3000.0", "-1.0", "6080.0"]
+    assert "c = -1" in rows[1]["error"] and not rows[0]["error"] and not rows[2]["error"]
+    for r in (rows[0], rows[2]):
+        direct = one_by_one(law="hertz", c=float(r["c"]))
+        assert float(r["F_peak"]) == pytest.approx(direct["F_peak"], rel=1e-12, abs=0)
+    assert "c = -1" in capsys.readouterr().err
 
 
 def test_monte_carlo_is_reproducible(tmp_path):
@@ -147,9 +142,8 @@ def monte_carlo(tmp_path_factory):
     drawn never let the striker go: t_end = 20 ms (the h20 contact lasts
     1.3 ms) instead of 1 s keeps them short."""
     out = tmp_path_factory.mktemp("monte_carlo")
-    done = subprocess.run([sys.executable, str(SWEEP), "--monte-carlo", str(N), "--scatter", "k=30%", "--scatter",
-                           "c=5", "--set", "t_end=0.02", "--seed", "11", "--workers", "2", "--out", str(out)],
-                          capture_output=True, text=True)
+    done = sweep_command("--monte-carlo", str(N), "--scatter", "k=30%", "--scatter", "c=5", "--set", "t_end=0.02",
+                         "--seed", "11", "--workers", "2", "--out", str(out))
     assert done.returncode == 0, done.stderr
     return out, done.stdout
 
@@ -196,7 +190,7 @@ def test_statistics_are_numpys_on_the_csv(monte_carlo):
 
 @pytest.mark.parametrize("args, message", [
     (["--vary", "height=0.1:0.01:0.01"], "stop >= start"),
-    (["--vary", "bogus=1"], "unknown option 'bogus'"),
+    (["--vary", "bogus=1"], "unknown parameter 'bogus'"),
     (["--monte-carlo", "5"], "needs at least one --scatter"),
     (["--workers", "0"], "must be >= 1"),
     (["--monte-carlo", "5", "--scatter", "c=-0.1"], "negative"),
@@ -205,9 +199,10 @@ def test_statistics_are_numpys_on_the_csv(monte_carlo):
     (["--monte-carlo", "5", "--scatter", "height=0.1"], "--set height="),
     (["--set", "law=foo"], "one of g1, hertz, g1x"),
     (["--vary", "impacts=1.5"], "impacts"),
-    (["--set", "csv=x.csv"], "writes its own CSV"),
-    (["--set", "output_interval=1e-6"], "writes its own CSV"),
-    (["--set", "json=true"], "always"),
+    (["--set", "csv=x.csv"], "unknown parameter 'csv'"),
+    (["--set", "output_interval=1e-6"], "unknown parameter 'output_interval'"),
+    (["--set", "json=true"], "unknown parameter 'json'"),
+    (["--vary", "law=g1:g1x:1"], "takes numbers"),
 ])
 def test_bad_sweeps_are_refused(args, message, tmp_path, capsys):
     with pytest.raises(SystemExit) as e:

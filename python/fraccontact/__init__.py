@@ -7,14 +7,18 @@ The model runs in-process on its C library:
     a = fraccontact.impacts(c=numpy.linspace(3e3, 9e3, 100))   # arrays, one library call
     s = fraccontact.simulate(output_interval=1e-5)       # s["t"], s["F"], ...
     fraccontact.fmu_path()                               # the FMI 2.0 FMU to co-simulate
+
+The console command `fraccontact` (python -m fraccontact) runs the h20
+example, fits, sweeps, co-simulations and the reports (fraccontact --help).
 """
 
 import os
 import pathlib
 
-from .model import Impact, Run, impact, impacts, parameters, simulate, warning
+from .model import Impact, Run, defaults, drop_velocity, impact, impacts, parameters, simulate, warning
 
-__all__ = ["Impact", "Run", "fmu_path", "impact", "impacts", "parameters", "simulate", "warning"]
+__all__ = ["Impact", "Run", "defaults", "drop_velocity", "fmu_path", "impact", "impacts", "parameters", "simulate",
+           "warning"]
 
 _HERE = pathlib.Path(__file__).resolve().parent
 _FMU_VARIABLES = {"fraccontact": "FRACCONTACT_FMU", "striker": "STRIKER_FMU"}

@@ -23,9 +23,20 @@ NAMES = tuple(p["name"] for p in _lib.PARAMETERS)
 
 def parameters():
     """Every parameter: name, kind, unit, default and help, from the C library."""
-    defaults = _default_params()
-    return [dict(name=p["name"], kind=p["kind"], unit=p["unit"], default=getattr(defaults, p["name"]),
-                 help=p["help"]) for p in _lib.PARAMETERS]
+    default = defaults()
+    return [dict(name=p["name"], kind=p["kind"], unit=p["unit"], default=default[p["name"]], help=p["help"])
+            for p in _lib.PARAMETERS]
+
+
+def defaults():
+    """{name: default} of every parameter: the paper's h20 drop test."""
+    p = _default_params()
+    return {name: getattr(p, name) for name in NAMES}
+
+
+def drop_velocity(height):
+    """The impact velocity sqrt(2 g h) of a drop from height h [m], g = 9.81 m/s^2."""
+    return _lib.LIB.fc_drop_velocity(float(height))
 
 
 def _default_params():
@@ -54,8 +65,8 @@ def _given(params):
         heights = np.asarray(height, dtype=float)
         if not np.all(np.isfinite(heights) & (heights >= 0)):
             raise ValueError(f"height = {height} is invalid: a drop height must be finite and >= 0 [m]")
-        params["v"] = np.vectorize(_lib.LIB.fc_drop_velocity, otypes=[float])(heights) if heights.ndim \
-            else _lib.LIB.fc_drop_velocity(float(heights))
+        params["v"] = np.vectorize(drop_velocity, otypes=[float])(heights) if heights.ndim \
+            else drop_velocity(heights)
     unknown = sorted(set(params) - set(NAMES))
     if unknown:
         raise TypeError(f"unknown parameter {', '.join(unknown)}; the parameters are {', '.join(NAMES)} and height")

@@ -6,18 +6,17 @@ workers. Writes docs/calibration.md and docs/calibration_sweep.png.
 Regenerate: scripts/report calibration   (about two minutes)
 """
 
-import argparse
 import csv
 import json
-import math
 import pathlib
+import tempfile
 
-import atomic
-import fit
-import sweep
+from .. import atomic, fit, model, reports, sweep
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-PAPER = dict(F_max=1004.0, eps=0.59, height=0.020, m=0.7437, k=3.299e8, c=6080.0, E_s=2.64e9)
+# The paper's h20 row (MODEL.md §6, Table 1): what was measured, and the
+# constants the paper fitted, which are the library's defaults.
+H20 = model.defaults()
+PAPER = dict(F_peak=1004.0, eps=0.59, height=0.020, m=H20["m"], k=H20["k"], c=H20["c"], E_s=H20["E_s"])
 
 
 def heights_sweep(out, k, c, workers=2):
@@ -41,33 +40,36 @@ def plot(path, paper_rows, fitted_rows):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
-    spec = [("F_peak", 1, "peak force F_max [N]"), ("eps", 1, "restitution coefficient eps"),
+    spec = [("F_peak", 1, "peak force F_peak [N]"), ("eps", 1, "restitution coefficient eps"),
             ("t_contact", 1e3, "contact time [ms]"), ("x2_end", 1e6, "permanent indentation [um]")]
     for ax, (key, scale, label) in zip(axes.flat, spec):
         for rows, name in ((paper_rows, "paper's k, c"), (fitted_rows, "k, c fitted to the h20 row")):
             ax.plot([r["height"] * 1e3 for r in rows], [r[key] * scale for r in rows], marker=".", label=name)
         if key == "F_peak":
-            ax.plot([20], [PAPER["F_max"]], "k*", ms=10, label="paper, h20 (measured fit target)")
+            ax.plot([20], [PAPER["F_peak"]], "k*", ms=10, label="paper, h20 (measured fit target)")
         if key == "eps":
             ax.plot([20], [PAPER["eps"]], "k*", ms=10)
         ax.set(xlabel="drop height [mm]", ylabel=label)
         ax.grid(alpha=0.3)
     axes.flat[0].legend(fontsize=8)
-    fig.suptitle("Drop-height sweep, 5 to 100 mm (m = 0.7437 kg, Hertz law)")
+    fig.suptitle(f"Drop-height sweep, 5 to 100 mm (m = {PAPER['m']:g} kg, Hertz law)")
     fig.tight_layout()
     atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
     parser.add_argument("--impacts", type=int, default=4000, help="impacts for the throughput runs (default 4000)")
-    args = parser.parse_args()
-    work = ROOT / "build" / "calibration"
-    v0 = math.sqrt(2 * fit.G * PAPER["height"])
-    k, c = fit.fit_peak_and_restitution(PAPER["F_max"], PAPER["eps"], PAPER["m"], v0)
-    E_s = fit.specimen_modulus(k, 6.35e-3, 210e9, 0.3, 0.4)
-    at_paper = fit.simulate(PAPER["k"], PAPER["c"], PAPER["m"], v0)
+    args = reports.parse(parser, argv)
+    with tempfile.TemporaryDirectory() as work:
+        write_report(args, pathlib.Path(work))
+
+
+def write_report(args, work):
+    v = model.drop_velocity(PAPER["height"])
+    k, c = fit.fit_peak_and_restitution(PAPER["F_peak"], PAPER["eps"], PAPER["m"], v)
+    E_s = fit.specimen_modulus(k, H20["R"], H20["E_i"], H20["nu_i"], H20["nu_s"])
+    at_paper = fit.run(PAPER["k"], PAPER["c"], PAPER["m"], v)
     paper_rows = heights_sweep(work / "paper", PAPER["k"], PAPER["c"])
     fitted_rows = heights_sweep(work / "fitted", k, c)
     plot(args.out / "calibration_sweep.png", paper_rows, fitted_rows)
@@ -77,40 +79,39 @@ def main():
              "Regenerate: `scripts/report calibration` (about two minutes; writes this file and "
              "`calibration_sweep.png`).", "",
              "## The paper's h20 row", "",
-             "`scripts/fit --fmax 1004 --eps 0.59 --height 0.020 --mass 0.7437` (Hertz law; indenter E_i = 210 GPa, "
-             "nu_i = 0.3, nu_s = 0.4, R = 6.35 mm):", "",
-             "| | k [N/m^1.5] | c [N s/m] | E_s [GPa] | F_max [N] | eps |", "|---|---|---|---|---|---|",
+             f"`fraccontact fit --F-peak 1004 --eps 0.59 --height 0.020 --m {PAPER['m']:g}` (Hertz law; indenter "
+             f"E_i = {H20['E_i'] / 1e9:g} GPa, nu_i = {H20['nu_i']:g}, nu_s = {H20['nu_s']:g}, "
+             f"R = {H20['R'] * 1e3:g} mm):", "",
+             "| | k [N/m^1.5] | c [N s/m] | E_s [GPa] | F_peak [N] | eps |", "|---|---|---|---|---|---|",
              f"| paper, Table 1 | {PAPER['k']:.4g} | {PAPER['c']:.4g} | {PAPER['E_s'] / 1e9:.3g} | 1004 (measured) | "
              f"0.59 (measured) |",
-             f"| this model with the paper's k, c | {PAPER['k']:.4g} | {PAPER['c']:.4g} | | {at_paper['F_peak']:.1f} | "
-             f"{at_paper['eps']:.4f} |",
+             f"| this model with the paper's k, c | {PAPER['k']:.4g} | {PAPER['c']:.4g} | | {at_paper.F_peak:.1f} | "
+             f"{at_paper.eps:.4f} |",
              f"| fitted here | {k:.4g} | {c:.4g} | {E_s / 1e9:.3g} | 1004.0 | 0.5900 |", "",
              f"The fit gives k {100 * (k / PAPER['k'] - 1):+.1f} %, c {100 * (c / PAPER['c'] - 1):+.1f} % and E_s "
              f"{100 * (E_s / PAPER['E_s'] - 1):+.1f} % against the paper: its constants were fitted through its own "
              "discrete scheme, which with them gives 1004 N where the exact model gives "
-             f"{at_paper['F_peak']:.0f} N. Either way the modulus stays about twice the 1.2 GPa of impact-tensile "
+             f"{at_paper.F_peak:.0f} N. Either way the modulus stays about twice the 1.2 GPa of impact-tensile "
              "tests, as the paper says.", "",
              "## Drop-height sweep", "",
-             "`scripts/sweep --vary height=0.005:0.1:0.005 --set law=hertz --set k=... --set c=...`, at the paper's constants and at "
+             "`fraccontact sweep --vary height=0.005:0.1:0.005 --set law=hertz --set k=... --set c=...`, at the "
+             "paper's constants and at "
              "the fitted ones. Peak force rises and contact time falls with the impact energy, as the paper's "
              "measurements do.", "", "![sweep](calibration_sweep.png)", "",
-             "| height [mm] | F_max [N], paper's k, c | eps | F_max [N], fitted | eps |", "|---|---|---|---|---|"]
+             "| height [mm] | F_peak [N], paper's k, c | eps | F_peak [N], fitted | eps |", "|---|---|---|---|---|"]
     for p, f in zip(paper_rows, fitted_rows):
         lines.append(f"| {p['height'] * 1e3:.0f} | {p['F_peak']:.1f} | {p['eps']:.4f} | {f['F_peak']:.1f} | "
                      f"{f['eps']:.4f} |")
     lines += ["", "## Throughput", "",
-              f"A Monte Carlo campaign of {args.impacts} impacts (k and c scattered by 5 % and 10 %) on a local Dask "
-              "cluster, each impact one run of fraccontact-solve (dt = 1e-7 s, about 13 000 internal steps), 25 "
-              "impacts a task:", "",
+              f"A Monte Carlo campaign of {args.impacts} impacts (k and c scattered by 5 % and 10 %, Hertz law, "
+              "dt = 1e-7 s, about 13 000 internal steps an impact) on a local Dask cluster, each task a chunk of "
+              "impacts in one call of the C library (`fraccontact sweep`, four tasks per worker):", "",
               "| workers | impacts per second | wall time |", "|---|---|---|",
               f"| 1 | {one['impacts_per_second']:.0f} | {one['wall_seconds']:.1f} s |",
               f"| 2 | {two['impacts_per_second']:.0f} | {two['wall_seconds']:.1f} s |", "",
               f"Two workers on this 2-core machine: {two['impacts_per_second'] / one['impacts_per_second']:.2f} times "
               "one. The same command takes `--scheduler tcp://HOST:8786` to spread a campaign over the workers of "
-              "any running Dask scheduler (they must reach the solver at the same path, `--solver`)."]
+              "any running Dask scheduler (whose workers must have the package installed)."]
     atomic.write_text(args.out / "calibration.md", "\n".join(lines) + "\n")
     print((args.out / "calibration.md").read_text())
 
-
-if __name__ == "__main__":
-    main()

@@ -11,24 +11,21 @@ Writes docs/benchmarks.md. Medians of repeated runs; CPU time of one process.
 Regenerate: scripts/report benchmarks   (a few minutes)
 """
 
-import argparse
-import json
 import math
-import pathlib
 import platform
-import subprocess
 import sys
 import time
 
 import numpy as np
 from scipy.special import gamma
 
-import atomic
 import differint.differint as differint
-from scipy_contact import solve_drop
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-K, C, M, V0 = 3.299e8, 6080.0, 0.7437, 0.626418
+from .. import atomic, model, reports, solver
+from ..scipy_contact import solve_drop
+
+H20 = model.defaults()
+K, C, M, V0 = H20["k"], H20["c"], H20["m"], H20["v"]
 TARGET = 1e-6
 DTS = [1e-5 / 2 ** i for i in range(12)]
 TOLERANCES = [10.0 ** -e for e in range(3, 13)]
@@ -39,14 +36,14 @@ def say(text):
 
 
 def run(program, *args):
-    done = subprocess.run([str(program), *map(str, args)], capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"{program} {' '.join(map(str, args))} failed: {done.stderr}")
-    return json.loads(done.stdout)
+    try:
+        return solver.run_json(program, *args)
+    except solver.Failed as e:
+        raise SystemExit(str(e)) from None
 
 
-def solve(solver, *args):
-    return run(solver, *args, "--json", "--quiet")
+def solve(program, *args):
+    return run(program, *args, "--json", "--quiet")
 
 
 def median_cpu(fn, budget=0.3, at_least=5):
@@ -76,21 +73,21 @@ def step_costs(bench):
 
 # --- 2. impacts per second at F_peak within 1e-6 --------------------------------
 
-def impacts_per_second(solver):
-    ref = solve(solver, "--reference", "--law", "hertz", "--rtol", "1e-12")
+def impacts_per_second(program):
+    ref = solve(program, "--reference", "--law", "hertz", "--rtol", "1e-12")
     rows = []
     for label, law in (("fraccontact-solve, Hertz law (SDIRK2)", "hertz"),
                        ("fraccontact-solve, G1 + Richardson (law 3)", "g1x")):
-        errs = {dt: abs(solve(solver, "--law", law, "--dt-max", dt)["F_peak"] / ref["F_peak"] - 1) for dt in DTS}
+        errs = {dt: abs(solve(program, "--law", law, "--dt-max", dt)["F_peak"] / ref["F_peak"] - 1) for dt in DTS}
         dt = first_setting_that_stays_within(DTS, errs.get)
-        r = solve(solver, "--law", law, "--dt-max", dt, "--repeat", 301)
+        r = solve(program, "--law", law, "--dt-max", dt, "--repeat", 301)
         rows.append(dict(label=label, setting=f"dt = {dt:.3g} s", error=errs[dt], cpu=r["cpu_seconds"]))
     say("  GSL reference ...")
     errs = {}
     for rtol in TOLERANCES:
-        errs[rtol] = abs(solve(solver, "--reference", "--law", "hertz", "--rtol", rtol)["F_peak"] / ref["F_peak"] - 1)
+        errs[rtol] = abs(solve(program, "--reference", "--law", "hertz", "--rtol", rtol)["F_peak"] / ref["F_peak"] - 1)
     rtol = first_setting_that_stays_within(TOLERANCES, errs.get)
-    r = solve(solver, "--reference", "--law", "hertz", "--rtol", rtol, "--repeat", 101)
+    r = solve(program, "--reference", "--law", "hertz", "--rtol", rtol, "--repeat", 101)
     rows.append(dict(label="GSL odeiv2 rk8pd (fraccontact-solve --reference)", setting=f"rtol = {rtol:.0e}",
                      error=errs[rtol], cpu=r["cpu_seconds"]))
     for method in ("LSODA", "DOP853", "Radau"):
@@ -189,7 +186,7 @@ def write(path, steps, impacts, g1, alpha):
             "N intervals of [0, 1]. Newest point: `g1_history_sum` (weights included) against "
             "`differint.GLpoint`; full grid: `g1_full_grid` (zero-padded FFT, the first N/128 points summed "
             "directly) against `differint.GL`. Errors are the largest over every grid point, relative to the "
-            "closed-form G1 value there (computed independently in scripts/benchmarks.py).", "",
+            "closed-form G1 value there (computed independently in fraccontact/reports/benchmarks.py).", "",
             "| N | ours, newest point | differint GLpoint | ratio | ours, full grid | differint GL | ratio | "
             "our worst error | differint GL worst error | differint GL points off by > 1e-9 | "
             "differint GLpoint error |", "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -210,22 +207,18 @@ def write(path, steps, impacts, g1, alpha):
     atomic.write_text(path, "\n".join(out) + "\n")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
-    args = parser.parse_args()
-    solver, bench = args.build / "fraccontact-solve", args.build / "fraccontact-bench"
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
+    reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
+    args = reports.parse(parser, argv)
+    program, bench = args.solver, solver.bench_path(args.solver)
     say("1/3 cost of a step ...")
     steps = step_costs(bench)
     say("2/3 impacts per second ...")
-    impacts = impacts_per_second(solver)
+    impacts = impacts_per_second(program)
     say("3/3 G1 against differint ...")
     g1 = g1_rows(bench, -0.5)
     args.out.mkdir(parents=True, exist_ok=True)
     write(args.out / "benchmarks.md", steps, impacts, g1, -0.5)
     print((args.out / "benchmarks.md").read_text())
 
-
-if __name__ == "__main__":
-    main()

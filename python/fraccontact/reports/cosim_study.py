@@ -7,8 +7,6 @@ docs/cosimulation.md and docs/cosimulation.png.
 Regenerate: scripts/report cosim_study   (about two minutes)
 """
 
-import argparse
-import pathlib
 
 import numpy as np
 
@@ -16,14 +14,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from cosim import COUPLINGS, M, ORDERS, V0, cosimulate, cosimulate_libcosim, monolithic  # noqa: E402
-import atomic  # noqa: E402
-from progress import progress  # noqa: E402
+from .. import atomic, hertz, model, reports  # noqa: E402
+from ..cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,  # noqa: E402
+                     fmu_paths, monolithic)
+from ..progress import progress  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
 STEPS = [float(f"{h:.3g}") for h in np.logspace(-6, -3, 31)]
-K = 3.299e8
-
+K = model.defaults()["k"]
 
 
 def largest_step_within(rows, key, bound):
@@ -45,12 +42,11 @@ def first_unstable(rows):
     return None
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
-    args = parser.parse_args()
-    contact, striker = args.build / "fraccontact.fmu", args.build / "striker.fmu"
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
+    add_fmu_options(parser)
+    args = reports.parse(parser, argv)
+    contact, striker = fmu_paths(parser, args)
     ref = monolithic(contact)
     runs = [(c, o) for c in COUPLINGS for o in ORDERS] + [(c, "libcosim") for c in COUPLINGS]
     total, done = len(runs) * len(STEPS), 0
@@ -111,18 +107,19 @@ def fmt_step(H):
 
 
 def write(path, results, ref):
-    omega = np.sqrt(1.5 * K * ((5 * M * V0 ** 2 / (4 * K)) ** 0.4) ** 0.5 / M)
+    omega = np.sqrt(1.5 * K * hertz.indentation(K, M, V0) ** 0.5 / M)
     out = ["# Co-simulation: striker FMU + contact FMU", "",
            "Regenerate: `scripts/report cosim_study` (about two minutes; writes this file and `cosimulation.png`). "
-           "The driver is `scripts/cosim.py` (fmpy's FMU API; also a command).", "",
-           "The paper's h20 drop test split in two FMUs: `striker.fmu` (a rigid body, m = 0.7437 kg, v0 = 0.626418 m/s, "
+           "The driver is `fraccontact/cosim.py` (fmpy's FMU API; also a command, "
+           "`fraccontact cosim`).", "",
+           f"The paper's h20 drop test split in two FMUs: `striker.fmu` (a rigid body, m = {M:g} kg, v0 = {V0:g} m/s, "
            "no gravity) and `fraccontact.fmu` in its driven scene (Hertz law, dt_max = 1e-7 s), the striker's "
            "velocity into the contact, the contact's force into the striker, for 3 ms. Against the monolithic "
            f"drop test (the contact FMU alone: F_peak = {ref['F_peak']:.6g} N, eps = {ref['eps']:.6g}), for "
            "communication steps H from 1e-6 s to 1e-3 s (31 steps, log-spaced).", "",
            "- **zoh**: the contact holds the striker's velocity over the step (m = 0) and the striker holds the "
            "contact force F of the last communication point;",
-           "- **mass-aware**: the contact runs a proxy striker of the same mass inside the step (m = 0.7437) and "
+           f"- **mass-aware**: the contact runs a proxy striker of the same mass inside the step (m = {M:g}) and "
            "the striker receives `F_avg`, the step's impulse divided by its length;",
            "- **jacobi**: both FMUs step from the values of the last point; **gauss-seidel**: the contact steps "
            "first and the striker takes its force of the same step.", "",
@@ -176,6 +173,3 @@ def agreement(results):
                 worst = max(worst, abs(a[key] - b[key]))
     return f"at every step and for both couplings its results match this driver's Jacobi runs within {worst:.1e}"
 
-
-if __name__ == "__main__":
-    main()

@@ -1,131 +1,127 @@
 """Parameter sweeps on Dask: the drop test over a grid of heights (the
 paper's 5 to 100 mm in 5 mm steps by default), masses, materials or any
-solver option, or a Monte Carlo campaign over their scatter; each impact is
-one run of fraccontact-solve. Prints a progress bar, writes a CSV of every
-impact and a plot of F_max, eps, contact time and permanent indentation
-against the swept variable (histograms for Monte Carlo).
+parameter of the model, or a Monte Carlo campaign over their scatter. Each
+Dask task runs a chunk of cases in one call of the C library
+(fraccontact.impacts: arrays in, arrays out). Prints a progress bar, writes a
+CSV of every impact and a plot of F_peak, eps, contact time and permanent
+indentation against the swept variable (histograms for Monte Carlo).
 
-  scripts/sweep                                   # the paper's heights, a local cluster
-  scripts/sweep --vary c=2000,6080,20000 --vary height=0.01:0.1:0.01
-  scripts/sweep --vary law=g1,hertz --vary t_end=0.05,0.2 --set impacts=3 --set g=9.81
-  scripts/sweep --monte-carlo 100000 --scatter k=0.05 --scatter c=10% --scheduler tcp://host:8786
+  fraccontact sweep                                   # the paper's heights, a local cluster
+  fraccontact sweep --vary c=2000,6080,20000 --vary height=0.01:0.1:0.01
+  fraccontact sweep --vary law=g1,hertz --vary t_end=0.05,0.2 --set impacts=3 --set g=9.81
+  fraccontact sweep --monte-carlo 100000 --scatter k=0.05 --scatter c=10% --scheduler tcp://host:8786
 
-NAME (--vary, --set, --scatter) is any option of fraccontact-solve (see its
---help; the sweep reads them from its --list-options) without the dashes,
-with - or _ alike: height, m, c, E-s or E_s, t-end or t_end, law, impacts.
-Real and integer options take a grid a:b:step or a list v1,v2; word options
-their choices (law=g1,hertz,g1x); flags true or false (reference=true). The
-sweep passes --json --quiet itself and writes its own CSV, so json, quiet,
-csv and output-interval are refused.
+NAME (--vary, --set, --scatter) is a parameter of the model, as
+fraccontact.parameters() lists them (the FMU's variables v, m, R, E_i,
+nu_i, E_s, nu_s, k, c, law, g1_nodes, dt_max, scene, g, gap0, the scheme and
+the stop conditions t_end and impacts), or height (the drop height: v =
+sqrt(2 g h)); - or _ alike: E_s or E-s, t_end or t-end. Real parameters
+take a grid a:b:step or a list v1,v2, integer ones too; law, scene and
+scheme also their words (law=g1,hertz,g1x).
 
-The default law: g1, the solver's own (the G1 history sum, the model the
+The default law: g1, the library's own (the G1 history sum, the model the
 README describes); --set law=hertz for the closed form.
 
 Monte Carlo: --scatter NAME=S draws NAME log-normally, with mean its nominal
-value (--set NAME=VALUE, else the default the solver states in its --help)
-and coefficient of variation S (standard deviation / mean), a fraction
-(0.05) or a percentage (5%). Log-normal, it stays positive at any S. Only
-real options with a positive nominal value scatter: a relative scatter of
-zero (g, gap0 at their defaults) or of a negative value means nothing, so
-those are refused, as is a negative S.
+value (--set NAME=VALUE, else the library's default) and coefficient of
+variation S (standard deviation / mean), a fraction (0.05) or a percentage
+(5%). Log-normal, it stays positive at any S. Only real parameters with a
+positive nominal value scatter: a relative scatter of zero (g, gap0 at
+their defaults) or of a negative value means nothing, so those are refused,
+as is a negative S.
 
-Writes to --out: sweep.csv (per impact: the inputs varied, then every scalar
-number of the solver's JSON but cpu_seconds, a timing that would make a
-seeded campaign's CSV differ between runs; NAME_result when NAME is also a
-column of the inputs, as impacts or k), sweep.png, and sweep.json (counts
-and throughput; for Monte Carlo also the mean, sample standard deviation and
-5/50/95 % percentiles of every numeric column over the impacts that
-succeeded, which are printed too).
+Writes to --out: sweep.csv (per impact: the inputs varied, then the run's
+figures as fraccontact.impact names them: the first impact's t_onset,
+v_onset, F_peak, eps, t_contact, x2_end, E_diss (NaN when none ended),
+impacts, steps and k; NAME_result when NAME is also a column of the inputs,
+as impacts or k; a case the library refuses has its message in the column
+error), sweep.png, and sweep.json (counts and throughput; for Monte Carlo
+also the mean, sample standard deviation and 5/50/95 % percentiles of every
+numeric column over the impacts that succeeded, which are printed too).
 
 Runs on a local Dask cluster (--workers processes) or on any running Dask
-scheduler (--scheduler ADDRESS), whose workers must see the same solver path
-(--solver, default build/fraccontact-solve).
+scheduler (--scheduler ADDRESS), whose workers must import fraccontact (pip
+install .). The wall time and the impacts per second count the Dask tasks
+alone, from the first submitted to the last finished (before, each worker
+has imported the package and run the first case once).
 """
 
 import argparse
 import csv
+import importlib
 import itertools
 import json
 import math
-import os
 import pathlib
-import re
-import subprocess
 import sys
 import time
 
 import numpy as np
 
-import atomic
-from progress import progress
+from . import atomic, model
+from .progress import progress
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-SOLVER = pathlib.Path(os.environ.get("FRACCONTACT_SOLVE", ROOT / "build" / "fraccontact-solve"))
-DEFAULT_LAW = "g1"
 DEFAULT_HEIGHTS = "0.005:0.1:0.005"
-# Solver options the sweep sets itself, or that only shape the --csv file it
-# does not ask for: refused, with the reason.
-SWEEP_OWNS = {
-    "--json": "the sweep always passes --json --quiet",
-    "--quiet": "the sweep always passes --json --quiet",
-    "--csv": "the sweep writes its own CSV (sweep.csv, a row per impact), not the solver's time series",
-    "--output-interval": "only spaces the rows of the solver's --csv, and the sweep writes its own CSV",
-}
-TIMING = "cpu_seconds"
+HEIGHT = dict(name="height", kind="real", unit="m", default=None, help="drop height: v = sqrt(2 g h)")
+# The results of a run, as fraccontact.impacts returns them: the first
+# impact's figures (NaN where none ended), then the run's counts and k.
+RESULTS = model.IMPACT_FIGURES + ("impacts", "steps", "k")
+COUNTS = ("impacts", "steps")
+# The default chunks: up to TASKS_PER_WORKER a worker, to balance the load and
+# show progress in a long campaign, but one a worker while that leaves fewer
+# than CHUNK_MIN cases in a chunk (a Dask task costs about 10 ms of round trip,
+# 250 cheap impacts: law 2, dt_max 3e-6).
+TASKS_PER_WORKER = 4
+CHUNK_MIN = 5000
 # The plotted results: (key, scale to the unit shown, what it is, unit).
-PLOTTED = (("F_peak", 1, "peak force F_max", "N"), ("eps", 1, "restitution coefficient eps", "1"),
+PLOTTED = (("F_peak", 1, "peak force F_peak", "N"), ("eps", 1, "restitution coefficient eps", "1"),
            ("t_contact", 1e3, "contact time", "ms"), ("x2_end", 1e6, "permanent indentation", "µm"))
-# "(default 3.299e8)" in an option's help: the solver's own statement.
-STATED_DEFAULT = re.compile(r"\(default ([-+]?[0-9][0-9.]*(?:[eE][-+]?[0-9]+)?)")
 
 
-def solver_options(solver):
-    """The solver's option table (--list-options), under every accepted
-    spelling of a name: without the dashes, and with _ for -."""
-    done = subprocess.run([str(solver), "--list-options"], capture_output=True, text=True)
-    if done.returncode != 0:
-        raise ValueError(f"{solver} --list-options failed ({done.stderr.strip()}): rebuild it (scripts/build)")
-    table = {}
-    for entry in json.loads(done.stdout):
-        name = entry["option"].lstrip("-")
-        table[name] = table[name.replace("-", "_")] = entry
-    return table
+def parameter_table():
+    """The library's parameters and height, by name."""
+    return {p["name"]: p for p in model.parameters() + [HEIGHT]}
 
 
-def option(table, name):
-    """The table entry of NAME; refused when unknown or the sweep's own."""
-    entry = table.get(name)
+def default_law():
+    """The library's default law, as a word."""
+    return next(word for word, code in model.WORDS["law"].items() if code == model.defaults()["law"])
+
+
+def parameter(table, name):
+    """The table entry of NAME (- or _ alike); refused when unknown."""
+    entry = table.get(name.replace("-", "_"))
     if entry is None:
-        names = sorted({e["option"][2:] for e in table.values() if e["option"] not in SWEEP_OWNS}, key=str.lower)
-        raise ValueError(f"unknown option '{name}': NAME is one of {', '.join(names)} (- or _ alike)")
-    if entry["option"] in SWEEP_OWNS:
-        raise ValueError(f"'{name}': {SWEEP_OWNS[entry['option']]}")
+        raise ValueError(f"unknown parameter '{name}': NAME is one of {', '.join(table)} (- or _ alike)")
     return entry
 
 
 def value(entry, text):
-    """TEXT as the option's kind: a number, one of its choices, true/false
-    for a flag, or the text itself."""
-    name, kind = entry["option"][2:], entry["kind"]
-    if kind in ("real", "integer"):
-        try:
-            return float(text) if kind == "real" else int(text)
-        except ValueError:
-            raise ValueError(f"{name}={text}: not {'a number' if kind == 'real' else 'a whole number'}") from None
-    choices = dict(true=True, false=False) if kind == "flag" else {c: c for c in entry.get("choices", [text])}
-    if text not in choices:
-        raise ValueError(f"{name}={text}: {name} is one of {', '.join(choices)}")
-    return choices[text]
+    """TEXT as the parameter's kind: a number, or for law, scene and scheme
+    also one of their words."""
+    name, kind = entry["name"], entry["kind"]
+    words = model.WORDS.get(name, {})
+    if text in words:
+        return text
+    try:
+        return float(text) if kind == "real" else int(text)
+    except ValueError:
+        if words:
+            raise ValueError(f"{name}={text}: {name} is one of {', '.join(words)} "
+                             f"(or {', '.join(map(str, words.values()))})") from None
+        raise ValueError(f"{name}={text}: not {'a number' if kind == 'real' else 'a whole number'}") from None
 
 
 def values(entry, spec):
-    """'a:b:step' (inclusive; real and integer options), or 'v1,v2,...'."""
-    if ":" not in spec or entry["kind"] not in ("real", "integer"):
+    """'a:b:step' (inclusive; real and integer parameters), or 'v1,v2,...'."""
+    if ":" not in spec:
         return [value(entry, v) for v in spec.split(",")]
     bounds = spec.split(":")
     if len(bounds) != 3:
         raise ValueError(f"'{spec}': a grid is start:stop:step")
     start, stop, step = (value(entry, x) for x in bounds)
+    if isinstance(start, str) or isinstance(stop, str) or isinstance(step, str):
+        raise ValueError(f"'{spec}': a grid start:stop:step takes numbers")
     if not step > 0 or stop < start:
         raise ValueError(f"'{spec}': start:stop:step needs step > 0 and stop >= start")
     n = int(math.floor((stop - start) / step + 1e-9)) + 1
@@ -134,9 +130,9 @@ def values(entry, spec):
 
 def scatter(entry, text):
     """The coefficient of variation in '0.05' or '5%'."""
-    name = entry["option"][2:]
+    name = entry["name"]
     if entry["kind"] != "real":
-        raise ValueError(f"--scatter {name}: only real options scatter, {name} is {entry['kind']}")
+        raise ValueError(f"--scatter {name}: only real parameters scatter, {name} is {entry['kind']}")
     try:
         cv = float(text[:-1]) / 100 if text.endswith("%") else float(text)
     except ValueError:
@@ -149,26 +145,24 @@ def scatter(entry, text):
 
 def pairs(table, texts, convert):
     """[(name, convert(entry, value))] of NAME=VALUE texts, each name as the
-    solver spells its option (without the dashes)."""
+    library spells it."""
     out = []
     for text in texts:
         name, sep, spec = text.partition("=")
         if not sep or not spec.strip():
             raise ValueError(f"'{text}': NAME=VALUE expected")
-        entry = option(table, name.strip().lstrip("-"))
-        out.append((entry["option"][2:], convert(entry, spec.strip())))
+        entry = parameter(table, name.strip().lstrip("-"))
+        out.append((entry["name"], convert(entry, spec.strip())))
     return out
 
 
 def nominal(entry, fixed):
-    """The mean a scattered option is drawn around: its --set value, else
-    the default the solver states."""
-    name = entry["option"][2:]
-    stated = STATED_DEFAULT.search(entry["help"])
-    if name not in fixed and not stated:
-        raise ValueError(f"--scatter {name}: the solver states no default for it; give its nominal value with "
-                         f"--set {name}=VALUE")
-    mean = fixed[name] if name in fixed else float(stated.group(1))
+    """The mean a scattered parameter is drawn around: its --set value, else
+    the library's default."""
+    name = entry["name"]
+    if name not in fixed and entry["default"] is None:
+        raise ValueError(f"--scatter {name}: it has no default; give its nominal value with --set {name}=VALUE")
+    mean = fixed[name] if name in fixed else entry["default"]
     if not mean > 0:
         raise ValueError(f"--scatter {name}: needs a positive nominal value, not {mean:g} (--set {name}=VALUE); a "
                          "relative scatter of zero or of a negative value means nothing")
@@ -194,44 +188,61 @@ def grid_cases(vary):
     return [dict(zip(names, combo)) for combo in itertools.product(*[v for _, v in vary])]
 
 
-def command(solver, options):
-    """The solver's command line: a flag appears when true, any other option
-    with its value."""
-    args = [str(solver), "--json", "--quiet"]
-    for name, v in options.items():
-        if v is True:
-            args.append(f"--{name}")
-        elif v is not False:
-            args += [f"--{name}", str(v)]
-    return args
+def code(name, v):
+    """A parameter's value as the library takes it (law=hertz -> 2)."""
+    return model.WORDS[name].get(v, v) if name in model.WORDS and isinstance(v, str) else v
 
 
-def scalar_results(result, case):
-    """What of the solver's JSON fits a CSV cell: numbers and true/false, and
-    NaN for a figure of the first impact when none ended (null). Strings
-    (stopped, method), lists and objects are skipped, cpu_seconds too (a
-    timing). A result named like an input of the case gets the suffix
-    _result: the input is asked (impacts: at most 3), the result is what
-    happened (impacts: 1 finished; k: the one derived from E_s when k = 0)."""
-    return {f"{key}_result" if key in case else key: math.nan if v is None else v for key, v in result.items()
-            if (v is None or isinstance(v, (int, float))) and key != TIMING}
+def run_chunk(fixed, columns):
+    """One Dask task: the cases whose parameters are the arrays in columns
+    (fixed holds the rest) in one library call. Returns the RESULTS as
+    arrays, and {index: the library's message} of the cases it refused,
+    whose results are NaN or 0 (then the cases run one by one, to tell which)."""
+    fixed = {name: code(name, v) for name, v in fixed.items() if name not in columns}  # a varied name wins
+    arrays = {name: np.array([code(name, v) for v in column]) for name, column in columns.items()}
+    n = len(next(iter(arrays.values())))
+    try:
+        out = model.impacts(**fixed, **arrays)
+        return {key: out[key] for key in RESULTS}, {}
+    except (ValueError, RuntimeError):
+        results = {key: np.zeros(n, dtype=np.int64) if key in COUNTS else np.full(n, np.nan) for key in RESULTS}
+        errors = {}
+        for i in range(n):
+            try:
+                out = model.impacts(**fixed, **{name: a[i] for name, a in arrays.items()})
+            except (ValueError, RuntimeError) as e:
+                errors[i] = str(e)
+                continue
+            for key in RESULTS:
+                results[key][i] = out[key]
+        return results, errors
 
 
-def run_batch(solver, fixed, cases):
-    """Runs a batch of impacts (one Dask task); returns their results."""
-    out = []
-    for case in cases:
-        done = subprocess.run(command(solver, dict(fixed, **case)), capture_output=True, text=True)
-        if done.returncode != 0:
-            out.append(dict(case, error=done.stderr.strip()))
+def rows_of(cases, results, errors):
+    """A row per case: its inputs, then its results (NAME_result when NAME is
+    an input too: the input is asked, impacts at most 3; the result is what
+    happened, 1 finished; k the one derived from E_s when k = 0), or the
+    library's message under error."""
+    columns = {key: results[key].tolist() for key in RESULTS}
+    rows = []
+    for i, case in enumerate(cases):
+        if i in errors:
+            rows.append(dict(case, error=errors[i]))
         else:
-            out.append(dict(case, **scalar_results(json.loads(done.stdout), case)))
-    return out
+            rows.append(dict(case, **{f"{key}_result" if key in case else key: columns[key][i] for key in RESULTS}))
+    return rows
+
+
+def chunks(cases, size):
+    """The cases in chunks of size, each as {name: [values]}."""
+    for start in range(0, len(cases), size):
+        part = cases[start:start + size]
+        yield start, {name: [case[name] for case in part] for name in part[0]}
 
 
 def run(args, cases):
-    """All cases on Dask, in batches; returns the results in case order and
-    the wall time."""
+    """All cases on Dask, in chunks of one library call each; returns the
+    rows in case order and the wall time of the tasks."""
     from dask.distributed import Client, LocalCluster, as_completed
     if args.scheduler:
         client = Client(args.scheduler)
@@ -240,18 +251,30 @@ def run(args, cases):
         cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)
         client = Client(cluster)
-    batches = [cases[i:i + args.batch] for i in range(0, len(cases), args.batch)]
+    # Before the clock starts, every worker imports the package and runs the
+    # first case once: the library loaded, the path of a chunk and its
+    # results taken (the first costs some 20 ms more than the next).
+    client.run(importlib.import_module, __name__)
+    workers = list(client.scheduler_info()["workers"])
+    _, first_case = next(chunks(cases[:1], 1))
+    client.gather([client.submit(run_chunk, args.fixed, first_case, workers=[w], pure=False) for w in workers])
+    n, w = len(cases), len(workers)
+    size = args.batch or max(math.ceil(n / (TASKS_PER_WORKER * w)), min(math.ceil(n / w), CHUNK_MIN))
+    parts, errors = {}, {}
     start = time.perf_counter()
-    futures = {client.submit(run_batch, str(args.solver), args.fixed, b, pure=False): i for i, b in enumerate(batches)}
-    results = [None] * len(batches)
+    futures = {client.submit(run_chunk, args.fixed, columns, pure=False): first
+               for first, columns in chunks(cases, size)}
     for done, future in enumerate(as_completed(futures), 1):
-        results[futures[future]] = future.result()
-        progress(done, len(batches), f"{min(done * args.batch, len(cases))} of {len(cases)} impacts")
+        first = futures[future]
+        parts[first], failed = future.result()
+        errors.update({first + i: why for i, why in failed.items()})
+        progress(done, len(futures), f"{min(done * size, len(cases))} of {len(cases)} impacts")
     wall = time.perf_counter() - start
     client.close()
     if cluster:
         cluster.close()
-    return [r for batch in results for r in batch], wall
+    results = {key: np.concatenate([parts[first][key] for first in sorted(parts)]) for key in RESULTS}
+    return rows_of(cases, results, errors), wall
 
 
 def write_csv(path, rows):
@@ -355,13 +378,14 @@ def title_of(args, rows):
     return ", ".join(parts)
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None, prog=None):
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=VALUES",
                         help=f"NAME=a:b:step or NAME=v1,v2,... (repeat for a grid; default height={DEFAULT_HEIGHTS})")
     parser.add_argument("--set", dest="fixed", action="append", default=[], metavar="NAME=VALUE",
-                        help=f"NAME=VALUE, a solver option held fixed (e.g. c=6080, law=hertz; default law: "
-                             f"{DEFAULT_LAW}, the solver's)")
+                        help=f"NAME=VALUE, a parameter held fixed (e.g. c=6080, law=hertz; default law: "
+                             f"{default_law()}, the library's)")
     parser.add_argument("--monte-carlo", type=int, default=0, metavar="N", help="N random impacts instead of a grid")
     parser.add_argument("--scatter", action="append", default=[], metavar="NAME=S",
                         help="NAME=S: NAME log-normal in --monte-carlo, coefficient of variation S as a fraction "
@@ -369,23 +393,22 @@ def main(argv=None):
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
     parser.add_argument("--workers", type=int, default=2, help="local cluster: worker processes (default 2)")
-    parser.add_argument("--batch", type=int, default=25, help="impacts per Dask task (default 25)")
-    parser.add_argument("--solver", type=pathlib.Path, default=SOLVER)
+    parser.add_argument("--batch", type=int, default=0,
+                        help=f"impacts per Dask task, one library call (default: {TASKS_PER_WORKER} tasks a worker, "
+                             f"or one while that leaves fewer than {CHUNK_MIN} impacts in a task)")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("sweep"),
                         help="folder for sweep.csv, sweep.png, sweep.json (default ./sweep)")
     args = parser.parse_args(argv)
     if args.monte_carlo and not args.scatter:
         parser.error("--monte-carlo needs at least one --scatter NAME=S")
-    if args.workers < 1 or args.batch < 1:
-        parser.error("--workers and --batch must be >= 1")
-    if not args.solver.exists():
-        parser.error(f"{args.solver} does not exist: run scripts/build (scripts/sweep does)")
+    if args.workers < 1 or args.batch < 0:
+        parser.error("--workers must be >= 1 and --batch >= 1 (or 0, the default)")
     if not args.vary and not args.monte_carlo:
         args.vary = [f"height={DEFAULT_HEIGHTS}"]
     try:
-        table = solver_options(args.solver)
+        table = parameter_table()
         args.vary = pairs(table, args.vary, values)
-        args.fixed = {"law": DEFAULT_LAW, **dict(pairs(table, args.fixed, value))}
+        args.fixed = {"law": default_law(), **dict(pairs(table, args.fixed, value))}
         args.scatter = pairs(table, args.scatter, scatter)
         cases = monte_carlo_cases(args, table) if args.monte_carlo else grid_cases(args.vary)
     except ValueError as e:
@@ -407,7 +430,3 @@ def main(argv=None):
     for r in failed[:5]:
         print(f"failed: {r}", file=sys.stderr)
     return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

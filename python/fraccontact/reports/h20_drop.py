@@ -2,21 +2,18 @@
 contact time and permanent indentation for both spring laws next to the
 paper's Table 1, and writes the time series (CSV) and a plot (PNG).
 
-Regenerate: scripts/run   (or: .venv/bin/python scripts/h20_drop.py --help)
+Regenerate: scripts/run   (fraccontact run --help)
 """
 
-import argparse
 import csv
-import pathlib
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from fmpy import simulate_fmu  # noqa: E402
 
-import atomic  # noqa: E402
+from .. import atomic, model, reports  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
 OUTPUTS = ["F", "x", "x1", "x2", "v_striker", "eps", "F_peak", "E_diss", "contact"]
@@ -81,23 +78,21 @@ def plot(path, results, figures):
     for ax in (ax_t, ax_x):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle("h20 drop test: m = 0.7437 kg, v0 = 0.626 m/s, k = 3.299e8 N/m^1.5, c = 6080 N s/m")
+    h20 = model.defaults()
+    k = f"{h20['k']:.4g}".replace("e+0", "e")
+    fig.suptitle(f"h20 drop test: m = {h20['m']:g} kg, v0 = {h20['v']:.3g} m/s, k = {k} N/m^1.5, "
+                 f"c = {h20['c']:g} N s/m")
     fig.tight_layout()
     atomic.save_figure(fig, path, dpi=110, metadata={"Software": None})
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--fmu", type=pathlib.Path, default=ROOT / "build" / "fraccontact.fmu",
-                        help="the FMU to simulate (default: build/fraccontact.fmu)")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs",
-                        help="folder for h20_drop.csv and h20_drop.png (default: docs/)")
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__, "folder for h20_drop.csv and h20_drop.png (default: docs/)")
+    reports.add_fmu(parser)
     parser.add_argument("--stop-time", type=float, default=3e-3, help="simulated time [s] (default 3e-3)")
     parser.add_argument("--output-interval", type=float, default=2e-6,
                         help="output sampling [s] (default 2e-6)")
-    args = parser.parse_args()
-    if not args.fmu.exists():
-        raise SystemExit(f"{args.fmu} does not exist: build it first (scripts/build)")
+    args = reports.parse(parser, argv)
     args.out.mkdir(parents=True, exist_ok=True)
 
     results = {law: simulate(args.fmu, law, args.stop_time, args.output_interval) for law in LAWS}
@@ -109,6 +104,3 @@ def main():
     plot(args.out / "h20_drop.png", results, figures)
     print(f"wrote {args.out / 'h20_drop.csv'} and {args.out / 'h20_drop.png'}")
 
-
-if __name__ == "__main__":
-    main()

@@ -29,26 +29,22 @@ exits 1 if any case fails.
 Regenerate: scripts/report hostile
 """
 
-import argparse
 import functools
 import json
 import math
-import pathlib
 import re
 import subprocess
 import sys
 
-import atomic
-from progress import progress
+from .. import atomic, hertz, model, reports, solver
+from ..progress import progress
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
 REALS = ["v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k", "c", "dt_max", "g", "gap0"]
 VALUES = {"0": 0.0, "negative": -1.0, "denormal": 5e-324, "huge": 1e300, "NaN": math.nan, "+Inf": math.inf,
           "-Inf": -math.inf}
 OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
-# The defaults of DESIGN.md's interface table: the paper's h20 test.
-DEFAULTS = dict(v=0.626418, m=0.7437, R=6.35e-3, E_i=210e9, nu_i=0.3, E_s=2.64e9, nu_s=0.4, k=3.299e8, c=6080.0,
-                dt_max=1e-7, g=0.0, gap0=0.0)
+# The library's defaults (DESIGN.md's interface table): the paper's h20 test.
+DEFAULTS = {name: model.defaults()[name] for name in REALS}
 GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
 DEFAULT_STEPS = [["step", 1e-5]] * 200          # 2 ms: the h20 impact (1.3 ms) and some flight
 
@@ -237,19 +233,17 @@ def recover(s, phase, name, before, snapshot):
 # One case in a child process of its own, so that a crash is a finding.
 CHILD = r'''
 import json, sys
-sys.path[:0] = [sys.argv[1], sys.argv[2]]
 from fmpy import extract, read_model_description
-from fmu_driver import Slave
-from hostile import run_case_in
-md = read_model_description(sys.argv[3])
-print(json.dumps(run_case_in(Slave(md, extract(sys.argv[3]), start=False), json.loads(sys.argv[4]))))
+from fraccontact.fmu import Slave
+from fraccontact.reports.hostile import run_case_in
+md = read_model_description(sys.argv[1])
+print(json.dumps(run_case_in(Slave(md, extract(sys.argv[1]), start=False), json.loads(sys.argv[2]))))
 '''
 
 
 def run_case(fmu, case):
     try:
-        done = subprocess.run([sys.executable, "-c", CHILD, str(ROOT / "tests"), str(ROOT / "scripts"), str(fmu),
-                               json.dumps(case)],
+        done = subprocess.run([sys.executable, "-c", CHILD, str(fmu), json.dumps(case)],
                               capture_output=True, text=True, timeout=300)
     except subprocess.TimeoutExpired:
         return dict(observed="HANG (over 300 s)", message="")
@@ -347,19 +341,14 @@ def params(case):
 
 def hertz_k(p):
     """k from the materials, MODEL.md §2."""
-    E_star = 1.0 / ((1 - p["nu_i"] ** 2) / p["E_i"] + (1 - p["nu_s"] ** 2) / p["E_s"])
-    return 4.0 / 3.0 * E_star * math.sqrt(p["R"])
+    return hertz.k_from_materials(p["R"], p["E_i"], p["nu_i"], p["E_s"], p["nu_s"])
 
 
 @functools.lru_cache(maxsize=None)
 def reference(solve, *args):
     """fraccontact-solve --reference --json (GSL's odeiv2 at rtol 1e-12,
     events to a few ulp): computed once per parameter set."""
-    done = subprocess.run([solve, "--reference", "--json", "--quiet", *args], capture_output=True, text=True,
-                          timeout=300)
-    if done.returncode != 0:
-        raise RuntimeError(f"{solve} --reference {' '.join(args)}: {done.stderr.strip()}")
-    return json.loads(done.stdout)
+    return solver.solve("--reference", *args, program=solve, timeout=300)
 
 
 def scheme_tolerance(N, h, T):
@@ -502,8 +491,8 @@ def check_elastic_hertz(j, case, r, solve):
     that follows (x - x2 = v (t - t_sep))."""
     p = params(case)
     m, k, v0 = p["m"], p["k"], p["v"]
-    x_max = (5 * m * v0 ** 2 / (4 * k)) ** 0.4
-    t_c = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9) * x_max / v0
+    x_max = hertz.indentation(k, m, v0)
+    t_c = hertz.contact_time(k, m, v0)
     h = internal_step(case)
     tol = scheme_tolerance(t_c / (2 * h), h, t_c)
     j.basis = f"Hertz closed forms, rel {tol:.2g}"
@@ -679,19 +668,17 @@ CHECKS = {"reference": check_reference, "constant rate": check_constant_rate, "r
 
 # --- the report ---------------------------------------------------------------
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--fmu", type=pathlib.Path, default=ROOT / "build" / "fraccontact.fmu")
-    parser.add_argument("--solve", type=pathlib.Path, default=ROOT / "build" / "fraccontact-solve",
-                        help="fraccontact-solve, for its --reference")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
-    args = parser.parse_args()
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
+    reports.add_fmu(parser)
+    reports.add_solver(parser, "fraccontact-solve, for its --reference")
+    args = reports.parse(parser, argv)
     all_cases = list(cases())
     rows = []
     for i, (name, c) in enumerate(all_cases):
         progress(i, len(all_cases), name)
         r = run_case(args.fmu, c)
-        rows.append((name, c, r, judge(name, c, r, str(args.solve))))
+        rows.append((name, c, r, judge(name, c, r, str(args.solver))))
     progress(len(all_cases), len(all_cases), "done")
     bad = [(n, c, r, j) for n, c, r, j in rows if j.failures]
     expected, observed = {}, {}
@@ -699,7 +686,8 @@ def main():
         expected[verdict_of(c)] = expected.get(verdict_of(c), 0) + 1
         observed[r["observed"]] = observed.get(r["observed"], 0) + 1
     out = ["# Hostile and degenerate input", "",
-           "Regenerate: `scripts/report hostile` (`scripts/hostile.py`; pytest runs the same cases and checks, "
+           "Regenerate: `scripts/report hostile` (`fraccontact/reports/hostile.py`; pytest runs the same cases and "
+           "checks, "
            "`tests/test_hostile.py`). Each case runs through fmpy in a process of its own, over 2 ms of the h20 "
            "drop test unless stated, and states the verdict it must reach:", "",
            "- **refused when set** / **at initialization** (rules that depend on the scene, the mass or the "
@@ -737,6 +725,3 @@ def main():
               f" [{r.get('message', '')}]")
     return 1 if bad else 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

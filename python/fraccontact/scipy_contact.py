@@ -10,6 +10,8 @@ located where x1' = 0.
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .hertz import indentation
+
 # x1 ~ v0 t at first: the solve starts a picosecond after contact so that the
 # separation event does not fire on the starting zero; the skipped interval
 # carries a force of ~1e-12 N and changes nothing measurable.
@@ -35,7 +37,7 @@ def solve_drop(k, c, m, v0, method="DOP853", rtol=1e-13, t_end=1.0, t_grid=None)
         return y[1] - force(y[0]) / c
     indentation_rate.direction = -1
 
-    x_ref = (5 * m * v0 ** 2 / (4 * k)) ** 0.4       # the Hertz indentation
+    x_ref = indentation(k, m, v0)
     atol = 1e-3 * rtol * np.array([x_ref, v0, x_ref, 0.5 * m * v0 ** 2])
     sol = solve_ivp(rhs, (T0, t_end), [v0 * T0, v0, 0.0, 0.0], method=method, rtol=rtol, atol=atol,
                     events=[separation, indentation_rate], dense_output=t_grid is not None)

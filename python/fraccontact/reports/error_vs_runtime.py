@@ -7,12 +7,9 @@ docs/error_vs_runtime.png.
 Regenerate: scripts/report error_vs_runtime   (after scripts/setup; it builds)
 """
 
-import argparse
 import csv
-import json
 import math
 import pathlib
-import subprocess
 import tempfile
 import time
 
@@ -22,12 +19,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-import atomic  # noqa: E402
-from progress import progress  # noqa: E402
-from scipy_contact import solve_drop  # noqa: E402
+from .. import atomic, model, reports, solver  # noqa: E402
+from ..progress import progress  # noqa: E402
+from ..scipy_contact import solve_drop  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-K, C, M, V0 = 3.299e8, 6080.0, 0.7437, 0.626418
+H20 = model.defaults()
+K, C, M, V0 = H20["k"], H20["c"], H20["m"], H20["v"]
 GRID = 1e-5                                   # the common time grid of the force curves
 DTS = [1e-5 / 2 ** i for i in range(14)]      # 1e-5 s ... 1.2e-9 s, each dividing GRID
 METRICS = ("F_peak", "eps", "t_contact", "x2_end", "F_curve")
@@ -46,11 +43,11 @@ TOLERANCES = [10.0 ** -e for e in range(3, 13)]
 
 
 
-def run(solver, *args):
-    done = subprocess.run([str(solver), *map(str, args), "--json", "--quiet"], capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"{solver} {' '.join(map(str, args))} failed: {done.stderr}")
-    return json.loads(done.stdout)
+def run(program, *args):
+    try:
+        return solver.solve(*args, program=program)
+    except solver.Failed as e:
+        raise SystemExit(str(e)) from None
 
 
 def force_on_grid(path):
@@ -71,12 +68,12 @@ def repeats_for(seconds):
     return int(min(401, max(5, 0.1 / max(seconds, 1e-7))))
 
 
-def solve_method(solver, options, dt, tmp):
+def solve_method(program, options, dt, tmp):
     """The errors from a run that writes the force curve; the time from a
     median of runs that write nothing."""
     path = tmp / "run.csv"
-    first = run(solver, *options, "--dt-max", dt, "--csv", path, "--output-interval", GRID)
-    timed = run(solver, *options, "--dt-max", dt, "--repeat", repeats_for(first["cpu_seconds"]))
+    first = run(program, *options, "--dt-max", dt, "--csv", path, "--output-interval", GRID)
+    timed = run(program, *options, "--dt-max", dt, "--repeat", repeats_for(first["cpu_seconds"]))
     first["cpu_seconds"] = timed["cpu_seconds"]
     return first, force_on_grid(path)
 
@@ -104,11 +101,10 @@ def observed_order(dts, errs):
     return float(np.polyfit(x, y, 1)[0])
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--solver", type=pathlib.Path, default=ROOT / "build" / "fraccontact-solve")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
-    args = parser.parse_args()
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
+    reports.add_solver(parser)
+    args = reports.parse(parser, argv)
     tmp = pathlib.Path(tempfile.mkdtemp())
 
     ref = run(args.solver, "--reference", "--law", "hertz", "--csv", tmp / "ref.csv", "--output-interval", GRID)
@@ -182,10 +178,11 @@ def fmt(x):
 
 
 def write_report(path, results, scipy_rows, gsl_rows, ref):
+    k = f"{K:.4g}".replace("e+0", "e")
     out = ["# Error against run time", "",
            "Regenerate: `scripts/report error_vs_runtime` (about half a minute; writes this file and "
            "`error_vs_runtime.png`).", "",
-           "The paper's h20 drop test (k = 3.299e8 N/m^1.5, c = 6080 N s/m, m = 0.7437 kg, v0 = 0.626418 m/s), "
+           f"The paper's h20 drop test (k = {k} N/m^1.5, c = {C:g} N s/m, m = {M:g} kg, v0 = {V0:g} m/s), "
            "first impact. Errors are relative, against fraccontact-solve's GSL reference (rk8pd, rtol 1e-12: "
            f"F_peak = {ref['F_peak']:.10g} N, eps = {ref['eps']:.10g}, t_contact = {ref['t_contact']:.10g} s, "
            f"x2_end = {ref['x2_end']:.10g} m), which itself agrees with scipy's DOP853 and Radau to 1e-9 "
@@ -251,6 +248,3 @@ def write_report(path, results, scipy_rows, gsl_rows, ref):
                        + " | ".join(fmt(r[m]) for m in METRICS) + " |")
     atomic.write_text(path, "\n".join(out) + "\n")
 
-
-if __name__ == "__main__":
-    main()

@@ -12,66 +12,38 @@ Orders:
   jacobi        both FMUs step from the values of the last point;
   gauss-seidel  the contact steps first, the striker then takes its force.
 
-Used by scripts/cosim_study.py and tests/test_cosim.py; also a command:
-  .venv/bin/python scripts/cosim.py --step 1e-4 --coupling mass-aware --order gauss-seidel
+Used by the cosim_study report and tests/test_cosim.py; also a command:
+  fraccontact cosim --step 1e-4 --coupling mass-aware --order gauss-seidel
 """
 
 import argparse
-import atexit
-import functools
 import json
 import pathlib
-import shutil
 
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy import read_model_description
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-M, V0 = 0.7437, 0.626418
+from . import fmu_path, model
+from .fmu import Slave, unpacked
+
+M, V0 = model.defaults()["m"], model.defaults()["v"]  # the h20 drop test's striker
 COUPLINGS = ("zoh", "mass-aware")
 ORDERS = ("jacobi", "gauss-seidel")
 
 
-@functools.lru_cache(maxsize=None)
-def unpacked(path):
-    """The FMU's model description and the folder it is extracted to: once
-    per file and process (a study makes hundreds of instances), removed when
-    the process exits. The instances share the folder's shared library."""
-    md = read_model_description(path)
-    folder = extract(path)
-    atexit.register(shutil.rmtree, folder, ignore_errors=True)
-    return md, folder
-
-
-class Unit:
-    """One FMU instance, its variables by name."""
+class Unit(Slave):
+    """One FMU instance of a co-simulation, named, its values set in
+    initialization mode; get() reads several reals at once."""
 
     def __init__(self, path, name, values):
-        md, self.folder = unpacked(str(pathlib.Path(path).resolve()))
-        self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        self.types = {v.name: v.type for v in md.modelVariables}
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.folder,
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate()
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
-        for key, value in values.items():
-            self.set(key, value)
+        md, folder = unpacked(str(pathlib.Path(path).resolve()))
+        super().__init__(md, folder, start=False, instance_name=name)
+        self.enter()
+        self.set(**values)
         self.fmu.exitInitializationMode()
 
-    def set(self, name, value):
-        if self.types[name] == "Integer":
-            self.fmu.setInteger([self.vr[name]], [int(value)])
-        else:
-            self.fmu.setReal([self.vr[name]], [float(value)])
-
     def get(self, *names):
-        values = self.fmu.getReal([self.vr[n] for n in names])
+        values = self.fmu.getReal([self.variables[n].valueReference for n in names])
         return values[0] if len(names) == 1 else values
-
-    def free(self):
-        self.fmu.terminate()
-        self.fmu.freeInstance()
 
 
 def monolithic(contact_fmu, t_end=3e-3, H=1e-5):
@@ -98,15 +70,15 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     t, n = 0.0, 0
     while t < t_end - 1e-15:
         v = striker.get("v")
-        contact.set("v", v)
+        contact.set(v=v)
         if order == "jacobi":
-            striker.set("F", F_held)
+            striker.set(F=F_held)
             striker.fmu.doStep(t, H)
             contact.fmu.doStep(t, H)
             F_held = contact.get(force)
         else:
             contact.fmu.doStep(t, H)
-            striker.set("F", contact.get(force))
+            striker.set(F=contact.get(force))
             striker.fmu.doStep(t, H)
         n += 1
         t = n * H
@@ -152,18 +124,35 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
     return dict(F_peak=F_peak, eps=-v_end / V0, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--contact", default=ROOT / "build" / "fraccontact.fmu", type=pathlib.Path)
-    parser.add_argument("--striker", default=ROOT / "build" / "striker.fmu", type=pathlib.Path)
+def add_fmu_options(parser):
+    """--contact and --striker: the FMUs, by default the package's (or
+    $FRACCONTACT_FMU, $STRIKER_FMU)."""
+    parser.add_argument("--contact", type=pathlib.Path, help="the contact FMU (default: fraccontact.fmu_path())")
+    parser.add_argument("--striker", type=pathlib.Path,
+                        help="the striker FMU (default: fraccontact.fmu_path('striker'))")
+
+
+def fmu_paths(parser, args):
+    """args.contact and args.striker, the defaults filled in; a missing FMU is a usage error."""
+    try:
+        return args.contact or fmu_path(), args.striker or fmu_path("striker")
+    except FileNotFoundError as e:
+        parser.error(str(e))
+
+
+def main(argv=None, prog=None):
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_fmu_options(parser)
     parser.add_argument("--step", type=float, default=1e-5, help="communication step [s] (default 1e-5)")
     parser.add_argument("--coupling", choices=COUPLINGS, default="mass-aware")
     parser.add_argument("--order", choices=ORDERS + ("libcosim",), default="gauss-seidel",
                         help="master order, or libcosim to run the scene in libcosim (Jacobi)")
-    parser.add_argument("--t-end", type=float, default=3e-3)
-    args = parser.parse_args()
+    parser.add_argument("--t-end", type=float, default=3e-3, help="simulated time [s] (default 3e-3)")
+    args = parser.parse_args(argv)
     if not args.step > 0:
         parser.error("--step must be positive")
+    args.contact, args.striker = fmu_paths(parser, args)
     if args.order == "libcosim":
         r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end)
     else:
@@ -172,6 +161,3 @@ def main():
     print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] - ref["eps"],
                           monolithic=ref)))
 
-
-if __name__ == "__main__":
-    main()

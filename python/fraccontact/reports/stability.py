@@ -1,8 +1,9 @@
-"""Stability and accuracy on stiff and extreme cases: fraccontact-solve over a
-matrix that crosses the dashpot c from 1e-2 to 1e9 N s/m, specimens from foam
-(1 MPa) to steel (210 GPa), v0 from 1e-4 to 30 m/s, m from 1 g to 1000 kg,
-steps from 1e-9 s to longer than the contact, N up to 1e6, zero velocity, a
-gap and repeated impacts with gravity.
+"""Stability and accuracy on stiff and extreme cases: the model (the C
+library in-process, fraccontact.impact) over a matrix that crosses the
+dashpot c from 1e-2 to 1e9 N s/m, specimens from foam (1 MPa) to steel
+(210 GPa), v0 from 1e-4 to 30 m/s, m from 1 g to 1000 kg, steps from 1e-9 s
+to longer than the contact, N up to 1e6, zero velocity, a gap and repeated
+impacts with gravity.
 
 Every run is checked for what holds at any step (finite, no tension,
 0 <= eps <= 1, the momentum invariant, no energy created, no force above
@@ -16,21 +17,19 @@ not a listed known finding, or a known finding no longer fails.
 Regenerate: scripts/report stability   (pytest runs the FAST subset)
 """
 
-import argparse
+import dataclasses
 import functools
-import json
 import math
-import pathlib
-import subprocess
 import sys
 import time
 
-import atomic
-from progress import progress
+from .. import atomic, hertz, model, reports, solver
+from ..progress import progress
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-BASE = dict(c=6080.0, E_s=2.64e9, v0=0.626418, m=0.7437, dt=1e-7, g1_nodes=0, gap0=0.0, g=0.0, impacts=1)
-R, E_I, NU_I, NU_S = 6.35e-3, 210e9, 0.3, 0.4
+H20 = model.defaults()
+# The paper's h20 test; a case changes some of these (v0 is the library's v, dt its dt_max).
+BASE = dict(c=H20["c"], E_s=H20["E_s"], v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g1_nodes=0, gap0=0.0, g=0.0,
+            impacts=1)
 MAX_STEPS = 4e7  # per run: keeps the matrix to minutes
 ULP = sys.float_info.epsilon
 # Rounding: a step rounds each of v, x1, x2 and E_diss once or twice, at most
@@ -118,18 +117,13 @@ KNOWN = {**{run: {ENERGY} for run in _ENERGY_RUNS}, **{run: {ENERGY, EPS} for ru
 
 
 def hertz_k(E_s):
-    return 4.0 / 3.0 * math.sqrt(R) / ((1 - NU_I ** 2) / E_I + (1 - NU_S ** 2) / E_s)
+    return hertz.k_from_materials(H20["R"], H20["E_i"], H20["nu_i"], E_s, H20["nu_s"])
 
 
 def g1_ratio(N):
     """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), the G1 law's stiffness over
     Hertz's on N intervals (MODEL.md §4); >= 1 for every N."""
     return math.exp(math.lgamma(N + 1.5) - math.lgamma(N) - 1.5 * math.log(N))
-
-
-# 2 int_0^1 (1 - u^(5/2))^(-1/2) du = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10)
-# (u^(5/2) = w turns it into a beta function): t_c = HERTZ_TC x_max / v.
-HERTZ_TC = 2.0 * math.sqrt(math.pi) * math.gamma(1.4) / math.gamma(0.9)
 
 
 def scales(case, law="hertz"):
@@ -150,8 +144,8 @@ def scales(case, law="hertz"):
         x = (case["m"] * g / K) ** (2 / 3)
         t_c = math.sqrt(x / g)
         return dict(K=K, t_c=t_c, t_F=t_c, V=x / t_c, x_max=x, v=0.0)
-    x = (5 * case["m"] * v ** 2 / (4 * K)) ** 0.4
-    t_c = HERTZ_TC * x / v
+    x = hertz.indentation(K, case["m"], v)
+    t_c = hertz.contact_time(K, case["m"], v)
     t_q = (case["c"] * v / K) ** (2 / 3) / v
     return dict(K=K, t_c=t_c, t_F=min(t_c, t_q), V=v, x_max=x, v=v)
 
@@ -202,40 +196,38 @@ def _key(case, law, t_end):
 
 
 def run_figures(out):
-    """The solver's JSON as the run's figures: the FMU's outputs where it
-    stopped (F_peak the largest, eps and t_contact the last impact's, E_diss
-    in all, x, x1, x2, v, t), its counts and every impact."""
+    """A run (fraccontact.impact's, or the solver's JSON, named alike) as its
+    figures: the FMU's outputs where it stopped (F_peak the largest, eps and
+    t_contact the last impact's, E_diss in all, x, x1, x2, v, t), its counts
+    and every impact."""
     return dict(out["end"], **{key: out[key] for key in ("impacts", "stopped", "steps", "k", "per_impact")})
 
 
 @functools.lru_cache(maxsize=None)
-def _solve(solver, key, rtol):
+def _solve(program, key, rtol):
     law, items, t_end = key[0], dict(key[1:-1]), key[-1]
-    args = [str(solver), "--json", "--quiet", "--law", law, "--k", "0", "--E-s", items["E_s"], "--c", items["c"],
-            "--v", items["v0"], "--m", items["m"], "--dt-max", items["dt"], "--g1-nodes", items["g1_nodes"],
-            "--gap0", items["gap0"], "--g", items["g"], "--impacts", items["impacts"], "--t-end", t_end]
-    if rtol:
-        args += ["--reference", "--rtol", rtol]
-    done = subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=1800)
-    if done.returncode != 0:
-        return None, done.stderr.strip()
+    params = dict(law=law, k=0.0, E_s=items["E_s"], c=items["c"], v=items["v0"], m=items["m"], dt_max=items["dt"],
+                  g1_nodes=items["g1_nodes"], gap0=items["gap0"], g=items["g"], impacts=items["impacts"], t_end=t_end)
     try:
-        return run_figures(json.loads(done.stdout)), ""
-    except json.JSONDecodeError:
-        return None, "not JSON (a non-finite number?): " + done.stdout[:200]
+        if not rtol:
+            return run_figures(dataclasses.asdict(model.impact(**params))), ""
+        options = [x for name, value in params.items() for x in ("--" + name.replace("_", "-"), value)]
+        return run_figures(solver.solve(*options, "--reference", "--rtol", rtol, program=program, timeout=1800)), ""
+    except (ValueError, RuntimeError) as e:  # solver.Failed is a RuntimeError
+        return None, str(e)
 
 
-def solve(solver, case, law, t_end, rtol=None):
-    """The solver's JSON (or the reference's at rtol), or (None, why). Runs
-    are cached: the G1 law with N = steps and the Hertz law share one
-    reference (the continuous limit), whatever the step."""
+def solve(program, case, law, t_end, rtol=None):
+    """The run in-process on the library (or fraccontact-solve's reference at
+    rtol), or (None, why). Runs are cached: the G1 law with N = steps and the
+    Hertz law share one reference (the continuous limit), whatever the step."""
     if rtol:
         if law == "g1" and case["g1_nodes"] == 0:
             law = "hertz"
         if law == "hertz":
             case = dict(case, g1_nodes=0)
         case = dict(case, dt=BASE["dt"])  # the reference does not step
-    return _solve(str(solver), _key(case, law, t_end), rtol)
+    return _solve(str(program), _key(case, law, t_end), rtol)
 
 
 def deviations(r, ref, sc):
@@ -257,11 +249,11 @@ def deviations(r, ref, sc):
     return d
 
 
-def reference_of(solver, case, law, t_end, sc):
+def reference_of(program, case, law, t_end, sc):
     """The reference at the tighter rtol and, per quantity, a bound on its
     own error (its distance to the looser one), or (None, None, why)."""
-    fine, err = solve(solver, case, law, t_end, REF_RTOLS[0])
-    coarse, err2 = solve(solver, case, law, t_end, REF_RTOLS[1])
+    fine, err = solve(program, case, law, t_end, REF_RTOLS[0])
+    coarse, err2 = solve(program, case, law, t_end, REF_RTOLS[1])
     if fine is None or coarse is None:
         return None, None, err or err2
     return fine, deviations(coarse, fine, sc), ""
@@ -342,7 +334,7 @@ def invariants(case, r):
     return out, fig
 
 
-def check(solver, case, law, name=None):
+def check(program, case, law, name=None):
     """Runs one case with one law; returns the figures and every check's
     outcome: row['checks'][check] is '' (pass), a failure text, or None (not
     applicable); row['failures'] lists the failures. Given the case's name,
@@ -352,7 +344,7 @@ def check(solver, case, law, name=None):
     t_end = t_end_of(case, sc["t_c"])
     row = dict(law=law, t_c=sc["t_c"], t_F=sc["t_F"], h=case["dt"] / sc["t_c"], h_F=case["dt"] / sc["t_F"],
                checks={}, failures=[])
-    r, err = solve(solver, case, law, t_end)
+    r, err = solve(program, case, law, t_end)
     if r is None:
         row["checks"]["finite"] = f"solver failed: {err}"
     else:
@@ -366,7 +358,7 @@ def check(solver, case, law, name=None):
     row["checks"].update(inv)
     row.update(fig)
     # The reference, for each figure whose time scale the step resolves.
-    ref, floor, err = reference_of(solver, case, law, t_end, sc)
+    ref, floor, err = reference_of(program, case, law, t_end, sc)
     if ref is None:
         row["checks"]["reference"] = f"reference failed: {err}"
     else:
@@ -413,7 +405,7 @@ LADDER = [RESOLVED * 2 ** k for k in range(6)]  # dt = T/20 ... T/640
 FAST_CONVERGENCE = {"h20, c = 6080"}
 
 
-def convergence(solver, name, case, law):
+def convergence(program, name, case, law):
     """Errors against the reference on the ladder dt = T/20 ... T/640 (T
     from time_scale: t_F for F_peak and E_diss, t_c for the rest): per quantity the largest error over
     (dt/T)^2 (or over dt/T for the G1 law with N = steps), the order of the
@@ -423,7 +415,7 @@ def convergence(solver, name, case, law):
     sc = scales(case, law)
     t_end = t_end_of(case, sc["t_c"], capped=False)
     first = law == "g1" and case["g1_nodes"] == 0
-    ref, floor, err = reference_of(solver, case, law, t_end, sc)
+    ref, floor, err = reference_of(program, case, law, t_end, sc)
     out = dict(name=name, law=law, constants={}, orders={}, failures=[])
     if ref is None:
         out["failures"].append(f"reference failed: {err}")
@@ -432,7 +424,7 @@ def convergence(solver, name, case, law):
         T = time_scale(sc, q)
         errors = []
         for n in LADDER:
-            r, err = solve(solver, dict(case, dt=T / n), law, t_end)
+            r, err = solve(program, dict(case, dt=T / n), law, t_end)
             if r is None:
                 out["failures"].append(f"{q}, dt = T/{n}: {err}")
                 break
@@ -456,12 +448,11 @@ def convergence(solver, name, case, law):
     return out
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--solver", type=pathlib.Path, default=ROOT / "build" / "fraccontact-solve")
-    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
+def main(argv=None, prog=None):
+    parser = reports.parser(prog, __doc__)
+    reports.add_solver(parser, "fraccontact-solve, for its GSL reference")
     parser.add_argument("--fast", action="store_true", help="the subset pytest runs")
-    args = parser.parse_args()
+    args = reports.parse(parser, argv)
     start = time.monotonic()
     regimes = [(n, c) for n, c in CONVERGENCE if not args.fast or n in FAST_CONVERGENCE]
     study = []
@@ -498,7 +489,8 @@ def write_report(path, study, rows, elapsed):
     out = ["# Stability and accuracy on stiff and extreme cases", "",
            f"Regenerate: `scripts/report stability` ({elapsed / 60:.1f} min here). `pytest` runs a fast subset "
            "(`tests/test_stability.py`) in CI.", "",
-           "Each case runs fraccontact-solve (implicit SDIRK2) with the G1 law (N = steps since onset, or the "
+           "Each case runs the model (implicit SDIRK2; the C library in-process, `fraccontact.impact`) with the G1 "
+           "law (N = steps since onset, or the "
            "case's fixed N) and the Hertz law, k derived from the materials (k = 0), from the paper's h20 test "
            "with one or more settings changed, until the impact(s) end or t_end (20 Hertz contact times t_c, "
            "more under gravity, at most 4e7 steps).", "",
@@ -506,7 +498,7 @@ def write_report(path, study, rows, elapsed):
            "What holds at any step, however coarse, with no allowance beyond rounding (4 ulp per step: a step "
            "rounds each state value once or twice by half an ulp, and an energy doubles the velocity's "
            "relative error):", "",
-           "- **finite**: every output finite (the solver refuses a non-finite state);",
+           "- **finite**: every output finite (the model refuses a non-finite state);",
            "- **no tension**: F_peak >= 0 and x1 >= 0;",
            "- **0 <= eps <= 1** for every impact (eps <= 1 only without gravity: under gravity an impact may "
            "gain gravity's work m g dx2);",
@@ -569,7 +561,8 @@ def write_report(path, study, rows, elapsed):
         out += ["## Failures", "",
                 "Every failure below fails a check that holds in the model at any step; none is widened to "
                 "pass. Those marked *known finding* are two properties of the time scheme (fmu_src/contact.c), "
-                "listed in `KNOWN` in scripts/stability.py so that a fix, or a new failure, stops the script:", ""]
+                "listed in `KNOWN` in fraccontact/reports/stability.py so that a fix, or a new failure, stops the "
+                "script:", ""]
         out += [f"- **{c}**: {FINDINGS[c]}" for c in FINDINGS] + [""]
         for n, r in failed:
             tag = "known finding" if not r["unexpected"] else "UNEXPECTED"
@@ -595,6 +588,3 @@ def write_report(path, study, rows, elapsed):
                    f"{f('momentum', '.1e')} | {f('force', '.1e')} | {ratio} | {dev} | {result} |")
     atomic.write_text(path, "\n".join(out) + "\n")
 
-
-if __name__ == "__main__":
-    sys.exit(main())

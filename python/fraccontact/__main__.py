@@ -1,0 +1,7 @@
+"""python -m fraccontact COMMAND ...: the console command (fraccontact.cli)."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,54 @@
+"""The console command: fraccontact COMMAND [OPTIONS...], each command
+documented by its own --help. Option names are the library's parameter
+names (--m, --v, --c, --E-s, --t-end: '-' for '_')."""
+
+import argparse
+import importlib
+import pkgutil
+import sys
+
+from . import reports
+
+COMMANDS = {
+    "run": "the paper's h20 drop test through the FMU: figures, docs/h20_drop.csv and .png (report h20_drop)",
+    "fit": "k, c and E_s from a drop test's F_peak and eps, or from a measured force curve",
+    "sweep": "parameter sweeps and Monte Carlo campaigns on Dask, a library call per task",
+    "cosim": "the drop test as two FMUs (striker + contact) coupled through fmpy or libcosim",
+    "report": "regenerate a report under docs/: fraccontact report NAME [OPTIONS...]",
+}
+MODULES = {"run": "fraccontact.reports.h20_drop", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
+           "cosim": "fraccontact.cosim"}
+
+
+def report_names():
+    """The reports: the modules of fraccontact.reports."""
+    return sorted(m.name for m in pkgutil.iter_modules(reports.__path__))
+
+
+def parser():
+    commands = "".join(f"  {name:<8} {what}\n" for name, what in COMMANDS.items())
+    p = argparse.ArgumentParser(prog="fraccontact", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter,
+                                epilog=f"commands:\n{commands}\nreports: {', '.join(report_names())}")
+    p.add_argument("command", choices=COMMANDS, metavar="COMMAND", help="one of " + ", ".join(COMMANDS))
+    p.add_argument("options", nargs=argparse.REMAINDER, help="the command's options (COMMAND --help)")
+    return p
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    prog = f"fraccontact {args.command}"
+    options = args.options
+    if args.command == "report":
+        names = report_names()
+        if not options or options[0] in ("-h", "--help"):
+            print(f"usage: {prog} NAME [OPTIONS...]\n\nRegenerates a report (NAME --help for its own).\n"
+                  f"NAME: {' | '.join(names)}", file=sys.stdout if options else sys.stderr)
+            return 0 if options else 2
+        if options[0] not in names:
+            print(f"{prog}: no report '{options[0]}'; NAME is one of {', '.join(names)}", file=sys.stderr)
+            return 2
+        module, prog, options = f"{reports.__name__}.{options[0]}", f"{prog} {options[0]}", options[1:]
+    else:
+        module = MODULES[args.command]
+    return importlib.import_module(module).main(options, prog=prog) or 0
