@@ -4,7 +4,6 @@ closed forms, identities) and against each other (a batch is the same runs
 one by one)."""
 
 import math
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest

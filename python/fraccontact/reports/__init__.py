@@ -7,6 +7,16 @@ import pathlib
 from .. import fmu_path, solver
 
 
+def source_tree():
+    """The repository a source-tree report works in (mutation, reliability:
+    they build and test copies of it): the current folder, which
+    scripts/report makes the repository's root."""
+    root = pathlib.Path.cwd()
+    if not (root / "CMakeLists.txt").exists() or not (root / "fmu_src").is_dir():
+        raise SystemExit(f"{root} is not the fraccontact repository: run this report from its root (scripts/report does)")
+    return root
+
+
 def parser(prog, doc, out_help="folder of the report (default: docs/)"):
     """A report's command line: its docstring as help, and --out."""
     p = argparse.ArgumentParser(prog=prog, description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)

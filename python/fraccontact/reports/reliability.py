@@ -15,12 +15,13 @@ import re
 import subprocess
 import sys
 
-import atomic
-from progress import progress
+from .. import atomic
+from ..progress import progress
+from . import source_tree
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-FMU_SOURCES = ["fmu_src/fmi2_cosim.c", "fmu_src/fmu_model.c", "fmu_src/fmu_vars.c", "fmu_src/serial.c",
-               "fmu_src/contact.c", "fmu_src/g1.c"]
+ROOT = source_tree()
+FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
+               "fmu_src/glue/serial.c", "fmu_src/model/contact.c", "fmu_src/model/g1.c"]
 
 
 def sh(*args, **kw):
@@ -72,7 +73,8 @@ def fuzz(seconds):
     out.mkdir(exist_ok=True)
     headers = sh(ROOT / ".venv/bin/python", "-c",
                  "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))").stdout.strip()
-    sh("clang", "-O1", "-fprofile-instr-generate", "-fcoverage-mapping", "-Ifmu_src", f"-I{headers}",
+    sh("clang", "-O1", "-fprofile-instr-generate", "-fcoverage-mapping", "-Ifmu_src/model", "-Ifmu_src/glue",
+       "-Ifmu_src/binding", f"-I{headers}",
        "-Ibuild/generated/fraccontact", "tests/fuzz_replay.c", "tests/fuzz_fmi2.c", *FMU_SOURCES, "-lm",
        "-o", out / "replay")
     inputs = sorted(str(p) for p in corpus.iterdir()) + sorted(str(p) for p in (ROOT / "tests/fuzz_corpus").iterdir())
@@ -155,12 +157,12 @@ def write(path, s, v, f, hostile_summary):
     atomic.write_text(path, "\n".join(lines) + "\n" + ("\n" + kept if kept else ""))
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None, prog=None):
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
     parser.add_argument("--fuzz-seconds", type=int, default=300)
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     progress(0, 4, "soak")
     s = soak(args.build)
     progress(1, 4, "valgrind")
@@ -168,9 +170,9 @@ def main():
     progress(2, 4, f"fuzzing {args.fuzz_seconds} s")
     f = fuzz(args.fuzz_seconds)
     progress(3, 4, "hostile input")
-    done = subprocess.run([sys.executable, ROOT / "scripts" / "hostile.py", "--out", args.out], capture_output=True,
-                          text=True)
-    summary = done.stdout.strip().splitlines()[0] if done.stdout.strip() else "hostile.py failed"
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "report", "hostile", "--out", args.out],
+                          capture_output=True, text=True)
+    summary = done.stdout.strip().splitlines()[0] if done.stdout.strip() else "the hostile report failed"
     progress(4, 4, "done")
     write(args.out / "reliability.md", s, v, f, f"Cases: {summary}.")
     print((args.out / "reliability.md").read_text())
@@ -178,6 +180,3 @@ def main():
         or not s["threads"]["identical_to_one_thread"] or s["instances"]["sampled_differ_from_alone"]
     return 1 if bad else 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

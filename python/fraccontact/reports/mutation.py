@@ -20,7 +20,7 @@ runs and named in the report (--strict-baseline stops instead).
 
 Writes the table between the markers <!-- mutation:begin --> and
 <!-- mutation:end --> of docs/reliability.md (appended when missing;
-scripts/reliability.py keeps that section when it rewrites the file).
+the reliability report keeps that section when it rewrites the file).
 
 Regenerate: scripts/report mutation   (about ten minutes on 2 cores: a killed
 mutant costs a rebuild and the tests up to its first failure, seconds; a
@@ -41,14 +41,14 @@ import shutil
 import signal
 import stat
 import subprocess
-import sys
 import tempfile
 import threading
 import time
 
-import atomic
+from .. import atomic
+from . import source_tree
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = source_tree()
 DOC = ROOT / "docs" / "reliability.md"
 BEGIN, END = "<!-- mutation:begin -->", "<!-- mutation:end -->"
 SLOW_LAST = ["test_stability.py", "test_sweep.py", "test_fit.py"]  # pytest runs these last, in this order
@@ -506,8 +506,8 @@ def source_description():
     return f"`{head.strip()}`" + (" with uncommitted changes" if dirty else "")
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def main(argv=None, prog=None):
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--list", action="store_true", help="list the mutants (checked against the sources) and stop")
     parser.add_argument("--only", nargs="+", metavar="NAME", help="run these mutants only; docs are left alone")
     parser.add_argument("--jobs", type=int, default=1, help="mutants at a time, each in its own copy (default 1)")
@@ -517,7 +517,7 @@ def main():
     parser.add_argument("--no-baseline", action="store_true", help="skip the unmutated run (faster, less safe)")
     parser.add_argument("--strict-baseline", action="store_true",
                         help="stop when a test fails unmutated (default: leave it out of the mutant runs, and say so)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
 
     names = [m.name for m in MUTANTS]
     assert len(set(names)) == len(names), "duplicate mutant names"
@@ -590,6 +590,3 @@ def main():
         print(f"wrote the table to {DOC.relative_to(ROOT)}")
     return 1 if survived else 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())
