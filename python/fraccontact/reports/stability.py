@@ -560,7 +560,7 @@ def write_report(path, study, rows, elapsed):
     if failed:
         out += ["## Failures", "",
                 "Every failure below fails a check that holds in the model at any step; none is widened to "
-                "pass. Those marked *known finding* are two properties of the time scheme (fmu_src/contact.c), "
+                "pass. Those marked *known finding* are two properties of the time scheme (fmu_src/model/contact.c), "
                 "listed in `KNOWN` in fraccontact/reports/stability.py so that a fix, or a new failure, stops the "
                 "script:", ""]
         out += [f"- **{c}**: {FINDINGS[c]}" for c in FINDINGS] + [""]
