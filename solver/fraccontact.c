@@ -134,36 +134,12 @@ double fc_default_output_interval(const fc_params *p)
 
 /* ------------------------------------------------------------ a run */
 
-typedef struct {
-    double *rows;
-    size_t n, cap;
-    int failed;
-} series;
-
-/* A row, unless it repeats the last one's time (an event on an output time). */
+/* The model's state as a row of the time series. */
 static void keep(series *s, const contact_model *cm)
 {
-    double *r;
-    if (s->failed || (s->n > 0 && !(cm->s.t > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
-        return;
-    if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 1024;
-        double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
-        if (!grown) {
-            s->failed = 1;
-            return;
-        }
-        s->rows = grown;
-        s->cap = cap;
-    }
-    r = s->rows + s->n++ * FC_COLUMNS;
-    r[FC_T] = cm->s.t;
-    r[FC_F] = cm->s.F;
-    r[FC_X] = contact_total_indentation(cm);
-    r[FC_X1] = contact_elastic_indentation(cm);
-    r[FC_X2] = cm->s.x2;
-    r[FC_V] = cm->s.v;
-    r[FC_E_DISS] = cm->s.E_diss;
+    const double row[FC_COLUMNS] = {cm->s.t, cm->s.F, contact_total_indentation(cm), contact_elastic_indentation(cm),
+                                    cm->s.x2, cm->s.v, cm->s.E_diss};
+    series_add(s, row);
 }
 
 /* Rows at the output times k * interval in (before->s.t, t], each the model

@@ -349,38 +349,11 @@ static int parse(int argc, char **argv, const option_table *t, options *o)
 
 /* ------------------------------------------------------------ results */
 
-/* The reference's rows, in the library's layout. */
-typedef struct {
-    double *rows;
-    size_t n, cap;
-    int failed;
-} series;
-
-/* A row, unless it repeats the last one's time (an event on an output time). */
+/* A row of the reference's time series. */
 static void keep(void *ctx, double t, double F, double x, double x1, double x2, double v, double E_diss)
 {
-    series *s = ctx;
-    double *r;
-    if (s->failed || (s->n > 0 && !(t > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
-        return;
-    if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 1024;
-        double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
-        if (!grown) {
-            s->failed = 1;
-            return;
-        }
-        s->rows = grown;
-        s->cap = cap;
-    }
-    r = s->rows + s->n++ * FC_COLUMNS;
-    r[FC_T] = t;
-    r[FC_F] = F;
-    r[FC_X] = x;
-    r[FC_X1] = x1;
-    r[FC_X2] = x2;
-    r[FC_V] = v;
-    r[FC_E_DISS] = E_diss;
+    const double row[FC_COLUMNS] = {t, F, x, x1, x2, v, E_diss};
+    series_add(ctx, row);
 }
 
 static int write_csv_rows(const char *tmp, const char *path, const double *rows, size_t n);

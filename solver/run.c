@@ -2,6 +2,24 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
+
+void series_add(series *s, const double row[FC_COLUMNS])
+{
+    if (s->failed || (s->n > 0 && !(row[FC_T] > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
+        return;
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 1024;
+        double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
+        if (!grown) {
+            s->failed = 1;
+            return;
+        }
+        s->rows = grown;
+        s->cap = cap;
+    }
+    memcpy(s->rows + s->n++ * FC_COLUMNS, row, FC_COLUMNS * sizeof *row);
+}
 
 int impact_list_add(impact_list *l, const fc_impact *f)
 {

@@ -13,6 +13,17 @@ typedef struct {
     size_t n, cap;
 } impact_list;
 
+/* Rows of a time series, FC_COLUMNS doubles each, grown geometrically. */
+typedef struct {
+    double *rows;
+    size_t n, cap;
+    int failed; /* memory ran out: rows since are lost */
+} series;
+
+/* Appends a row, unless it repeats the last one's time (an event on an
+ * output time). */
+void series_add(series *s, const double row[FC_COLUMNS]);
+
 /* The model's parameters of a run. */
 void fc_model_params(const fc_params *p, contact_params *q);
 
