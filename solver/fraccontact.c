@@ -18,8 +18,15 @@ static const fc_parameter parameters[] = {
     {"E_s", FC_REAL, AT(E_s), "Pa", "specimen Young's modulus (used only with k = 0)"},
     {"nu_s", FC_REAL, AT(nu_s), "1", "specimen Poisson ratio (used only with k = 0)"},
     {"k", FC_REAL, AT(k), "N/m1.5",
-     "Hertz constant; 0 derives it from R, E_i, nu_i, E_s, nu_s; any other value wins over them"},
-    {"c", FC_REAL, AT(c), "N.s/m", "dashpot constant"},
+     "spring constant [N/m^n]; 0 derives the Hertz constant from R, E_i, nu_i, E_s, nu_s (n = 1.5 only); any "
+     "other value wins over them"},
+    {"spring_exponent", FC_REAL, AT(spring_exponent), "1",
+     "n in F = k x1^n: 1.5 Hertz sphere, 1 linear spring (flat punch), 2 cone-like tip"},
+    {"c", FC_REAL, AT(c), "N.s/m", "dashpot constant (damper 1)"},
+    {"damper_order", FC_REAL, AT(damper_order), "1", "the springpot's order alpha in (0, 1]; 1 is a dashpot (damper 2)"},
+    {"c_alpha", FC_REAL, AT(c_alpha), "N.s^alpha/m", "springpot constant: F = c_alpha D^alpha x2 (damper 2)"},
+    {"memory_tolerance", FC_REAL, AT(memory_tolerance), "1",
+     "relative error of the compressed memory's kernel, from dt_max to 1000 s (memory 2)"},
     {"dt_max", FC_REAL, AT(dt_max), "s", "largest internal step"},
     {"g", FC_REAL, AT(g), "m/s2", "acceleration of the striker towards the specimen (9.81 for gravity)"},
     {"gap0", FC_REAL, AT(gap0), "m", "gap between striker and specimen at t = 0"},
@@ -28,6 +35,9 @@ static const fc_parameter parameters[] = {
     {"g1_nodes", FC_INTEGER, AT(g1_nodes), "1", "G1 intervals N; 0: internal steps since contact onset"},
     {"scene", FC_INTEGER, AT(scene), "1", "1 drop test (a free striker), 2 driven (the rate v prescribed)"},
     {"scheme", FC_INTEGER, AT(scheme), "1", "1 SDIRK2 (implicit, L-stable), 2 the paper's explicit central differences"},
+    {"damper", FC_INTEGER, AT(damper), "1", "1 dashpot F = c x2', 2 springpot F = c_alpha D^alpha x2 (fractional memory)"},
+    {"memory", FC_INTEGER, AT(memory), "1",
+     "the springpot's memory: 1 full G1 history (steps of dt_max, O(N) each), 2 compressed (sum of exponentials)"},
     {"impacts", FC_INTEGER, AT(impacts), "1", "stop right after this many impacts have ended"},
 };
 
@@ -49,7 +59,11 @@ void fc_model_params(const fc_params *p, contact_params *q)
     q->E_s = p->E_s;
     q->nu_s = p->nu_s;
     q->k = p->k;
+    q->spring_exponent = p->spring_exponent;
     q->c = p->c;
+    q->damper_order = p->damper_order;
+    q->c_alpha = p->c_alpha;
+    q->memory_tolerance = p->memory_tolerance;
     q->dt_max = p->dt_max;
     q->g = p->g;
     q->gap0 = p->gap0;
@@ -57,6 +71,8 @@ void fc_model_params(const fc_params *p, contact_params *q)
     q->g1_nodes = p->g1_nodes;
     q->scene = p->scene;
     q->scheme = p->scheme;
+    q->damper = p->damper;
+    q->memory = p->memory;
 }
 
 void fc_params_default(fc_params *p)
@@ -71,7 +87,11 @@ void fc_params_default(fc_params *p)
     p->E_s = q.E_s;
     p->nu_s = q.nu_s;
     p->k = q.k;
+    p->spring_exponent = q.spring_exponent;
     p->c = q.c;
+    p->damper_order = q.damper_order;
+    p->c_alpha = q.c_alpha;
+    p->memory_tolerance = q.memory_tolerance;
     p->dt_max = q.dt_max;
     p->g = q.g;
     p->gap0 = q.gap0;
@@ -79,6 +99,8 @@ void fc_params_default(fc_params *p)
     p->g1_nodes = q.g1_nodes;
     p->scene = q.scene;
     p->scheme = q.scheme;
+    p->damper = q.damper;
+    p->memory = q.memory;
     p->t_end = 1.0;
     p->impacts = 1;
 }
@@ -112,11 +134,12 @@ int fc_params_warning(const fc_params *p, char *msg, size_t len)
     return contact_unused_material(&q, msg, len);
 }
 
-/* t_c v / x_max of an elastic Hertz impact (MODEL.md §2):
- * 2 integral_0^1 (1 - u^(5/2))^(-1/2) du = (4/5) B(2/5, 1/2). */
-static double elastic_contact_time(void)
+/* t_c v / x_max of an elastic impact on the spring k x1^n (MODEL.md §2):
+ * 2 integral_0^1 (1 - u^(n+1))^(-1/2) du = 2/(n+1) B(1/(n+1), 1/2). */
+static double elastic_contact_time(double n)
 {
-    return 0.8 * tgamma(0.4) * tgamma(0.5) / tgamma(0.9);
+    const double e = 1.0 / (n + 1.0);
+    return 2.0 * e * tgamma(e) * tgamma(0.5) / tgamma(e + 0.5);
 }
 
 double fc_default_output_interval(const fc_params *p)
@@ -129,7 +152,7 @@ double fc_default_output_interval(const fc_params *p)
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
     contact_scales(&q, contact_spring_stiffness(&cm, 0), p->v, p->m, &x_ref, &t_ref, &x_small);
-    return t_ref > 0.0 ? elastic_contact_time() * t_ref / 256.0 : p->t_end / 1000.0;
+    return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref / 256.0 : p->t_end / 1000.0;
 }
 
 /* ------------------------------------------------------------ a run */
@@ -154,6 +177,21 @@ static void keep_rows_until(series *out, const contact_model *before, double t, 
             return;
         keep(out, &at);
     }
+}
+
+/* The full G1 history lives on its grid and cannot be copied cheaply: its
+ * rows are the grid points at or just after the output times. */
+static int rows_on_grid(const contact_params *q)
+{
+    return q->damper == CONTACT_DAMPER_SPRINGPOT && q->memory == CONTACT_MEMORY_G1;
+}
+
+static void keep_grid_rows_until(series *out, const contact_model *cm, double interval, int64_t *k)
+{
+    if (!(interval > 0.0 && (double)*k * interval <= cm->s.t))
+        return;
+    keep(out, cm);
+    *k = (int64_t)floor(cm->s.t / interval) + 1;
 }
 
 static int why_stop(const fc_params *p, const contact_model *cm)
@@ -195,10 +233,11 @@ static fc_impact finished_impact(const contact_state *s, double E_diss_onset)
     return done;
 }
 
-/* Ends a run that failed where cm is, with a message already written. */
-static fc_status failed(const contact_model *cm, fc_outcome *o, fc_status status)
+/* Ends a run where cm is (with a message already written if it failed). */
+static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 {
     summarize(cm, o);
+    contact_release(cm);
     return o->status = status;
 }
 
@@ -208,7 +247,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
                      fc_progress progress, void *ctx, fc_outcome *o, char *msg, size_t len)
 {
     contact_params q;
-    contact_model cm;
+    contact_model cm, snapshot;
     double E_diss_onset = 0.0;
     int64_t k = 1, reported = 0;
     memset(o, 0, sizeof *o);
@@ -219,28 +258,39 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     if (out)
         keep(out, &cm);
     while (!(o->stop = why_stop(p, &cm))) {
-        const contact_model before = cm;
+        const contact_state before = cm.s;
         double H = p->t_end - cm.s.t;
-        if (cm.s.in_contact || q.scheme == CONTACT_SCHEME_CENTRAL)
+        int rows_inside;
+        if (rows_on_grid(&q))
+            H = q.dt_max;
+        else if (cm.s.in_contact || contact_steps_uniformly(&cm))
             H = fmin(H, q.dt_max);
+        if (contact_check_advance(&cm, H, msg, len) != 0)
+            return finish(&cm, o, FC_EFAIL);
+        rows_inside = out && interval > 0.0 && !rows_on_grid(&q) && (double)k * interval <= cm.s.t + H;
+        if (rows_inside)
+            snapshot = cm; /* no G1 history in it: a plain copy */
         if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
             contact_reject(msg, len, "t", cm.s.t, "the state became non-finite in the step from here [s]");
-            return failed(&cm, o, FC_EFAIL);
+            return finish(&cm, o, FC_EFAIL);
         }
-        if (cm.s.in_contact && !before.s.in_contact)
-            E_diss_onset = before.s.E_diss;
-        if (cm.s.impacts > before.s.impacts) {
+        if (cm.s.in_contact && !before.in_contact)
+            E_diss_onset = before.E_diss;
+        if (cm.s.impacts > before.impacts) {
             fc_impact done = finished_impact(&cm.s, E_diss_onset);
             if (cm.s.impacts == 1)
                 o->first = done;
             if (impacts && impact_list_add(impacts, &done) != 0) {
                 contact_reject(msg, len, "impacts", (double)cm.s.impacts, "out of memory for the per-impact figures");
-                return failed(&cm, o, FC_ENOMEM);
+                return finish(&cm, o, FC_ENOMEM);
             }
         }
         if (out) {
-            keep_rows_until(out, &before, cm.s.t, interval, &k);
-            if (interval == 0.0 || cm.s.in_contact != before.s.in_contact)
+            if (rows_on_grid(&q))
+                keep_grid_rows_until(out, &cm, interval, &k);
+            else if (rows_inside)
+                keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
+            if (interval == 0.0 || cm.s.in_contact != before.in_contact)
                 keep(out, &cm);
         }
         if (progress && cm.s.steps - reported >= 65536) {
@@ -252,10 +302,10 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         keep(out, &cm);
         if (out->failed) {
             contact_reject(msg, len, "rows", (double)out->n, "out of memory for the time series");
-            return failed(&cm, o, FC_ENOMEM);
+            return finish(&cm, o, FC_ENOMEM);
         }
     }
-    return failed(&cm, o, FC_OK);
+    return finish(&cm, o, FC_OK);
 }
 
 fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress, void *ctx,

@@ -54,8 +54,12 @@ typedef struct {
     double nu_i;     /* indenter Poisson ratio */
     double E_s;      /* specimen Young's modulus [Pa] */
     double nu_s;     /* specimen Poisson ratio */
-    double k;        /* Hertz constant [N/m^1.5]; 0: derive from R, E_i, nu_i, E_s, nu_s */
+    double k;        /* spring constant [N/m^n]; 0: the Hertz constant from R, E_i, nu_i, E_s, nu_s */
+    double spring_exponent; /* n in F = k x1^n (1.5 Hertz sphere) */
     double c;        /* dashpot constant [N s/m] */
+    double damper_order;     /* the springpot's alpha in (0, 1] */
+    double c_alpha;          /* springpot constant [N s^alpha/m] */
+    double memory_tolerance; /* relative error of the compressed memory's kernel */
     double dt_max;   /* largest internal step [s] */
     double g;        /* acceleration of the striker towards the specimen [m/s^2] */
     double gap0;     /* gap between striker and specimen at t = 0 [m] */
@@ -64,6 +68,8 @@ typedef struct {
     int g1_nodes;    /* G1 intervals N; 0: internal steps since contact onset */
     int scene;       /* 1 drop test, 2 driven */
     int scheme;      /* 1 SDIRK2 (implicit, L-stable), 2 the paper's central differences */
+    int damper;      /* 1 dashpot, 2 springpot (MODEL.md §7) */
+    int memory;      /* the springpot's memory: 1 full G1 history, 2 compressed (MODEL.md §8) */
     int impacts;     /* stop right after this many impacts have ended */
 } fc_params;
 

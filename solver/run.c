@@ -43,8 +43,10 @@ void contact_scales(const contact_params *p, double K, double v0, double m, doub
     *x_ref = *t_ref = *x_small = 0.0;
     if (!(v > 0.0 && (v0 > 0.0 || g > 0.0)))
         return;
-    x_dashpot = pow(v * p->c / K, 2.0 / 3.0);
-    *x_ref = m > 0.0 ? pow(1.25 * m * v * v / K, 0.4) : x_dashpot;
+    /* K x^n = c v, and K x^(n+1)/(n+1) = m v^2/2 */
+    x_dashpot = pow(v * p->c / K, 1.0 / p->spring_exponent);
+    *x_ref = m > 0.0 ? pow(0.5 * (p->spring_exponent + 1.0) * m * v * v / K, 1.0 / (p->spring_exponent + 1.0))
+                     : x_dashpot;
     *t_ref = *x_ref / v;
     *x_small = fmin(*x_ref, x_dashpot);
 }

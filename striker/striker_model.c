@@ -178,8 +178,9 @@ static const state_field state_fields[] = {F(F), F(m), F(g), F(x0), F(v0), F(t),
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
 
-size_t fm_state_size(void)
+size_t fm_state_size(const fmu_model *fm)
 {
+    (void)fm;
     return fmu_fields_size(state_fields, N_STATE_FIELDS);
 }
 
@@ -188,9 +189,11 @@ void fm_state_write(const fmu_model *fm, unsigned char *bytes)
     fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
 }
 
-fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 {
     fmu_model trial = *fm;
+    if (size != fm_state_size(fm))
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
     fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
         || (trial.started != 0 && trial.started != 1))

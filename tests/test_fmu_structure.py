@@ -19,8 +19,10 @@ def knowns(md):
 def perturbed(v):
     """A different valid value for the known."""
     if v.type == "Integer":
-        return {"law": 2, "g1_nodes": 5, "scene": 2}[v.name]
+        return {"law": 2, "g1_nodes": 5, "scene": 2, "damper": 2, "memory": 1}[v.name]
     start = float(v.start)
+    if v.name == "memory_tolerance":
+        return start * 10.0
     return start * 1.5 + 0.1 if v.name not in ("nu_i", "nu_s") else start * 0.5
 
 

@@ -1,6 +1,7 @@
 #include "fmu_model.h"
 
 #include "fmu_vars.h"
+#include "serial.h"
 
 #include <inttypes.h>
 #include <math.h>
@@ -30,7 +31,11 @@ static const fmu_variable variable_list[] = {
     {VR_E_s, "E_s", VAR_REAL, VAR_PARAMETER, PARAM(E_s)},
     {VR_nu_s, "nu_s", VAR_REAL, VAR_PARAMETER, PARAM(nu_s)},
     {VR_k, "k", VAR_REAL, VAR_PARAMETER, PARAM(k)},
+    {VR_spring_exponent, "spring_exponent", VAR_REAL, VAR_PARAMETER, PARAM(spring_exponent)},
     {VR_c, "c", VAR_REAL, VAR_PARAMETER, PARAM(c)},
+    {VR_damper_order, "damper_order", VAR_REAL, VAR_PARAMETER, PARAM(damper_order)},
+    {VR_c_alpha, "c_alpha", VAR_REAL, VAR_PARAMETER, PARAM(c_alpha)},
+    {VR_memory_tolerance, "memory_tolerance", VAR_REAL, VAR_PARAMETER, PARAM(memory_tolerance)},
     {VR_dt_max, "dt_max", VAR_REAL, VAR_PARAMETER, PARAM(dt_max)},
     {VR_g, "g", VAR_REAL, VAR_PARAMETER, PARAM(g)},
     {VR_gap0, "gap0", VAR_REAL, VAR_PARAMETER, PARAM(gap0)},
@@ -47,6 +52,8 @@ static const fmu_variable variable_list[] = {
     {VR_law, "law", VAR_INTEGER, VAR_PARAMETER, PARAM(law)},
     {VR_g1_nodes, "g1_nodes", VAR_INTEGER, VAR_PARAMETER, PARAM(g1_nodes)},
     {VR_scene, "scene", VAR_INTEGER, VAR_PARAMETER, PARAM(scene)},
+    {VR_damper, "damper", VAR_INTEGER, VAR_PARAMETER, PARAM(damper)},
+    {VR_memory, "memory", VAR_INTEGER, VAR_PARAMETER, PARAM(memory)},
     {VR_contact, "contact", VAR_BOOLEAN, VAR_OUTPUT, 0},
 };
 
@@ -74,9 +81,11 @@ static void preview_start(fmu_model *fm)
     if (fm->started)
         return;
     if (contact_check_params(&fm->params, why, sizeof why) == 0
-        && contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0)
+        && contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0) {
         /* The mass only scales the dynamics, which a preview does not run. */
+        contact_release(&fm->model);
         contact_start(&fm->model, &fm->params, fm->v, fm->m > 0.0 ? fm->m : 1.0);
+    }
 }
 
 fmu_model *fm_new(fm_report report, void *env)
@@ -92,6 +101,7 @@ fmu_model *fm_new(fm_report report, void *env)
 
 void fm_free(fmu_model *fm)
 {
+    contact_release(&fm->model);
     free(fm);
 }
 
@@ -103,6 +113,7 @@ double fm_time(const fmu_model *fm)
 void fm_reset(fmu_model *fm)
 {
     fmu_reporter log = fm->log;
+    contact_release(&fm->model);
     memset(fm, 0, sizeof *fm);
     fm->log = log;
     contact_default_params(&fm->params);
@@ -232,9 +243,9 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     case VR_F: *value = F_rate; break;
     case VR_x: *value = cm->s.v; break;
     case VR_x1: *value = x1_rate; break;
-    case VR_x2: *value = cm->s.F * cm->inv_c; break;
+    case VR_x2: *value = contact_damper_rate(cm); break;
     case VR_v_striker: *value = v_rate; break;
-    case VR_E_diss: *value = cm->s.F * cm->s.F * cm->inv_c; break;
+    case VR_E_diss: *value = cm->s.F * contact_damper_rate(cm); break;
     case VR_semi_integral: *value = F_rate * contact_semi_integral_per_force(cm); break;
     default:
         return report(fm, FM_ERROR, "logStatusError",
@@ -256,6 +267,7 @@ fm_status fm_start(fmu_model *fm, double t0)
     if (contact_check_params(&fm->params, why, sizeof why) != 0
         || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    contact_release(&fm->model);
     contact_start(&fm->model, &fm->params, fm->v, fm->m);
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
@@ -263,6 +275,29 @@ fm_status fm_start(fmu_model *fm, double t0)
     if (contact_unused_material(&fm->params, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     return FM_OK;
+}
+
+/* What a refused step puts back beside the state: the damper's rate and a
+ * compressed memory's modes (a full G1 history keeps its past; the state's
+ * step count says how much of it counts). */
+typedef struct {
+    size_t count;
+    double values[CONTACT_MAX_MODES + 1];
+} memory_copy;
+
+static void save_memory(const contact_model *cm, memory_copy *copy)
+{
+    size_t i, count = contact_memory_count(cm);
+    copy->count = count < CONTACT_MAX_MODES + 1 ? count : 1;
+    for (i = 0; i < copy->count; i++)
+        copy->values[i] = contact_memory_get(cm, i);
+}
+
+static void restore_memory(contact_model *cm, const memory_copy *copy)
+{
+    size_t i;
+    for (i = 0; i < copy->count; i++)
+        contact_memory_set(cm, i, copy->values[i]);
 }
 
 static void report_events(fmu_model *fm, const contact_state *before)
@@ -280,6 +315,8 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
 {
     contact_model *cm = &fm->model;
     contact_state before;
+    memory_copy memory;
+    char why[512];
     double impulse, F_avg = fm->F_avg;
     const fmu_variable *overflow;
     /* About a minute of CPU: beyond that a step is a mistake, not a wish. */
@@ -290,8 +327,11 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
     if (H == 0.0)
         return FM_OK;
+    if (contact_check_advance(cm, H, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "fmi2DoStep: communicationStepSize = %.17g: %s", H, why);
     contact_drive(cm, fm->v, fm->m, fm->v_slope);
     before = cm->s;
+    save_memory(cm, &memory);
     impulse = contact_advance(cm, H);
     if (isnan(impulse))
         return report(fm, FM_ERROR, "logStatusError",
@@ -302,6 +342,7 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     if (overflow) {
         double value = real_output(fm, overflow->vr);
         cm->s = before;
+        restore_memory(cm, &memory);
         fm->F_avg = F_avg;
         return report(fm, FM_ERROR, "logStatusError",
                       "fmi2DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
@@ -326,36 +367,98 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
-    I(params.scheme), F(v), F(m), F(v_slope), F(F_avg), I(started), F(model.inv_m), F(model.accel),
-    CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
+    I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), I(started),
+    F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
+
+/* A springpot's parameters follow, then its memory: the count of values
+ * (u64) and the values (contact_memory_get). A dashpot's state ends above. */
+static const state_field springpot_fields[] = {F(params.damper_order), F(params.c_alpha), F(params.memory_tolerance),
+                                               I(params.memory)};
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
+#define N_SPRINGPOT_FIELDS (sizeof springpot_fields / sizeof springpot_fields[0])
 
-size_t fm_state_size(void)
+static int has_springpot(const contact_params *p) { return p->damper == CONTACT_DAMPER_SPRINGPOT; }
+
+size_t fm_state_size(const fmu_model *fm)
 {
-    return fmu_fields_size(state_fields, N_STATE_FIELDS);
+    size_t size = fmu_fields_size(state_fields, N_STATE_FIELDS);
+    if (has_springpot(&fm->params))
+        size += fmu_fields_size(springpot_fields, N_SPRINGPOT_FIELDS) + 8 + 8 * contact_memory_count(&fm->model);
+    return size;
 }
 
 void fm_state_write(const fmu_model *fm, unsigned char *bytes)
 {
+    size_t i, count;
     fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
+    if (!has_springpot(&fm->params))
+        return;
+    bytes += fmu_fields_size(state_fields, N_STATE_FIELDS);
+    fmu_fields_write(fm, springpot_fields, N_SPRINGPOT_FIELDS, bytes);
+    bytes += fmu_fields_size(springpot_fields, N_SPRINGPOT_FIELDS);
+    count = contact_memory_count(&fm->model);
+    serial_put_u64(bytes, count);
+    for (i = 0; i < count; i++)
+        serial_put_double(bytes + 8 + 8 * i, contact_memory_get(&fm->model, i));
 }
 
-fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes)
+/* The parameters and the state of `bytes` into *trial, and the count of the
+ * memory's values that follow at *memory; NULL, or what is wrong. */
+static const char *read_fields(fmu_model *trial, const unsigned char *bytes, size_t size, const unsigned char **memory,
+                               size_t *count)
+{
+    const size_t fixed = fmu_fields_size(state_fields, N_STATE_FIELDS);
+    const size_t springpot = fmu_fields_size(springpot_fields, N_SPRINGPOT_FIELDS);
+    *count = 0;
+    if (size < fixed)
+        return "the FMU state is too short";
+    fmu_fields_read(trial, state_fields, N_STATE_FIELDS, bytes);
+    if (!has_springpot(&trial->params))
+        return size == fixed ? NULL : "the FMU state has the wrong length";
+    if (size < fixed + springpot + 8)
+        return "the FMU state is too short";
+    fmu_fields_read(trial, springpot_fields, N_SPRINGPOT_FIELDS, bytes + fixed);
+    *memory = bytes + fixed + springpot + 8;
+    *count = (size_t)serial_get_u64(bytes + fixed + springpot);
+    if (*count > (size - fixed - springpot - 8) / 8 || size != fixed + springpot + 8 + 8 * *count)
+        return "the FMU state has the wrong length";
+    return NULL;
+}
+
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 {
     fmu_model trial = *fm;
+    const unsigned char *memory = NULL;
+    const char *problem;
     char why[256];
-    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
+    size_t i, count;
+    problem = read_fields(&trial, bytes, size, &memory, &count);
+    if (problem)
+        return report(fm, FM_ERROR, "logStatusError", "%s", problem);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
         || contact_check_striker(&trial.params, CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
-    if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || (trial.started != 0 && trial.started != 1)
-        || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1))
+    if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
+        || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
+        || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
+    for (i = 0; i < count; i++)
+        if (!isfinite(serial_get_double(memory + 8 * i)))
+            return report(fm, FM_ERROR, "logStatusError", "the FMU state's damper memory holds a non-finite value");
     contact_configure(&trial.model, &trial.params);
     if (nonfinite_output(&trial))
         return report(fm, FM_ERROR, "logStatusError", "the FMU state gives the output %s a non-finite value",
                       nonfinite_output(&trial)->name);
+    if (contact_memory_accepts(&trial.model, count, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "the FMU state does not fit its parameters: %s", why);
+    /* trial shares fm's G1 history buffer: growing it is the last thing
+     * that can fail, and leaves fm as it was if it does. */
+    if (contact_memory_resize(&trial.model, count) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "out of memory for the FMU state's G1 history (%lu values)",
+                      (unsigned long)count);
+    for (i = 0; i < count; i++)
+        contact_memory_set(&trial.model, i, serial_get_double(memory + 8 * i));
     *fm = trial;
     return FM_OK;
 }

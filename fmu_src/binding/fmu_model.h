@@ -17,7 +17,8 @@ enum fmu_vr {
     VR_k = 8, VR_c = 9, VR_dt_max = 10, VR_g = 11, VR_gap0 = 12,
     VR_F = 13, VR_F_avg = 14, VR_F_peak = 15, VR_x = 16, VR_x1 = 17, VR_x2 = 18,
     VR_v_striker = 19, VR_E_diss = 20, VR_eps = 21, VR_semi_integral = 22,
-    VR_law = 30, VR_g1_nodes = 31, VR_scene = 32,
+    VR_spring_exponent = 23, VR_damper_order = 24, VR_c_alpha = 25, VR_memory_tolerance = 26,
+    VR_law = 30, VR_g1_nodes = 31, VR_scene = 32, VR_damper = 33, VR_memory = 34,
     VR_contact = 40
 };
 

@@ -445,22 +445,29 @@ typedef struct {
     unsigned char bytes[1]; /* size bytes follow */
 } fmu_state;
 
-static size_t state_size(void)
+static size_t state_size(const instance *in)
 {
-    return STATE_HEADER + STATE_INSTANCE + fm_state_size();
+    return STATE_HEADER + STATE_INSTANCE + fm_state_size(in->fm);
 }
 
-static fmu_state *new_state(void)
+/* A state of `size` bytes: `reuse` if it has that size, else a new one
+ * (and `reuse` freed). */
+static fmu_state *state_of_size(fmu_state *reuse, size_t size)
 {
-    fmu_state *state = malloc(offsetof(fmu_state, bytes) + state_size());
-    if (state)
-        state->size = state_size();
+    fmu_state *state;
+    if (reuse && reuse->size == size)
+        return reuse;
+    state = malloc(offsetof(fmu_state, bytes) + size);
+    if (state) {
+        state->size = size;
+        free(reuse);
+    }
     return state;
 }
 
 static void write_state(const instance *in, unsigned char *b)
 {
-    size_t payload = state_size() - STATE_HEADER;
+    size_t payload = state_size(in) - STATE_HEADER;
     unsigned char *p = b + STATE_HEADER;
     serial_put_u32(p, (uint32_t)in->state);
     serial_put_double(p + 4, in->start_time);
@@ -476,14 +483,15 @@ static void write_state(const instance *in, unsigned char *b)
  * otherwise what is wrong with them. */
 static const char *state_problem(const unsigned char *b, size_t size)
 {
-    size_t payload = state_size() - STATE_HEADER;
+    size_t payload;
     if (size < STATE_HEADER || memcmp(b, STATE_MAGIC, 4) != 0)
         return "not a " FMU_MODEL_IDENTIFIER " FMU state";
     if (serial_get_u32(b + 4) != STATE_FORMAT)
         return "an FMU state of another format version";
     if (serial_get_u32(b + 8) != serial_crc32((const unsigned char *)FMU_GUID, strlen(FMU_GUID)))
         return "an FMU state of another FMU (its GUID differs)";
-    if (serial_get_u32(b + 12) != payload || size != state_size())
+    payload = serial_get_u32(b + 12);
+    if (payload < STATE_INSTANCE || size != STATE_HEADER + payload)
         return "an FMU state of the wrong length (truncated, or of another version)";
     if (serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))
         return "a corrupted FMU state (its checksum does not match)";
@@ -502,7 +510,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
     REQUIRE(ANY_STATE, "fmi2GetFMUstate");
     if (!FMUstate)
         return fail(in, "fmi2GetFMUstate: FMUstate is NULL");
-    state = *FMUstate ? (fmu_state *)*FMUstate : new_state(); /* a given state is overwritten */
+    state = state_of_size(*FMUstate, state_size(in)); /* a given state is overwritten */
     if (!state)
         return fail(in, "fmi2GetFMUstate: out of memory");
     write_state(in, state->bytes);
@@ -528,7 +536,8 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
         snprintf(message, sizeof message, "fmi2SetFMUstate: %s", problem);
         return fail(in, message);
     }
-    if (fm_state_read(in->fm, state->bytes + STATE_HEADER + STATE_INSTANCE) != FM_OK)
+    if (fm_state_read(in->fm, state->bytes + STATE_HEADER + STATE_INSTANCE,
+                      state->size - STATE_HEADER - STATE_INSTANCE) != FM_OK)
         return fmi2Error;
     in->start_time = serial_get_double(state->bytes + STATE_HEADER + 4);
     in->state = (int)mode;
@@ -588,7 +597,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
         snprintf(message, sizeof message, "fmi2DeSerializeFMUstate: %s (%lu bytes)", problem, (unsigned long)size);
         return fail(in, message);
     }
-    state = *FMUstate ? (fmu_state *)*FMUstate : new_state();
+    state = state_of_size(*FMUstate, size);
     if (!state)
         return fail(in, "fmi2DeSerializeFMUstate: out of memory");
     memcpy(state->bytes, serializedState, size);

@@ -44,11 +44,12 @@ fm_status fm_start(fmu_model *fm, double t0);
 fm_status fm_do_step(fmu_model *fm, double t, double H);
 double fm_time(const fmu_model *fm);
 
-/* The model's part of the FMU state, as fm_state_size() bytes in the
- * platform-independent layout of serial.h. fm_state_read takes it back only
- * if it describes a valid model (else FM_ERROR, a report, nothing changed). */
-size_t fm_state_size(void);
+/* The model's part of the FMU state, as fm_state_size(fm) bytes in the
+ * platform-independent layout of serial.h (a model with a growing memory
+ * needs more as it runs). fm_state_read takes `size` bytes back only if they
+ * describe a valid model (else FM_ERROR, a report, nothing changed). */
+size_t fm_state_size(const fmu_model *fm);
 void fm_state_write(const fmu_model *fm, unsigned char *bytes);
-fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes);
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size);
 
 #endif

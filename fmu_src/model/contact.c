@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "g1.h"
+#include "soe.h"
 
 /* Gamma(5/2) = 3 sqrt(pi) / 4: x1^(3/2) = Gamma(5/2) D^(-1/2) x1 (MODEL.md §3). */
 #define GAMMA_5_2 1.329340388179137
@@ -19,6 +20,12 @@
  * a diverging state could reach it. */
 #define MAX_EVENTS_PER_STEP 1000
 
+/* While a springpot's dent recovers in free flight, its memory relaxes on
+ * the time scale of the time since separation: steps of this fraction of
+ * it (at least dt_max) keep SDIRK2's error per step near 1e-4 of the
+ * recovery, in O(log) steps however long the flight. */
+#define RECOVERY_STEP_FRACTION 0.125
+
 void contact_default_params(contact_params *p)
 {
     p->R = 6.35e-3;
@@ -27,7 +34,13 @@ void contact_default_params(contact_params *p)
     p->E_s = 2.64e9;
     p->nu_s = 0.4;
     p->k = 3.299e8;
+    p->spring_exponent = 1.5;
     p->c = 6080.0;
+    /* A springpot as damping as the dashpot at the impact's frequency
+     * omega = pi / t_c ~ 2400 rad/s: c_alpha omega^alpha = c omega. */
+    p->damper_order = 0.5;
+    p->c_alpha = 3e5;
+    p->memory_tolerance = 1e-6;
     p->dt_max = 1e-7;
     p->g = 0.0;
     p->gap0 = 0.0;
@@ -35,6 +48,8 @@ void contact_default_params(contact_params *p)
     p->g1_nodes = 0;
     p->scene = CONTACT_SCENE_DROP;
     p->scheme = CONTACT_SCHEME_SDIRK2;
+    p->damper = CONTACT_DAMPER_DASHPOT;
+    p->memory = CONTACT_MEMORY_COMPRESSED;
 }
 
 void contact_default_striker(double *v, double *m)
@@ -87,8 +102,19 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return contact_reject(msg, len, "nu_s", p->nu_s, "a Poisson ratio must lie in (-1, 0.5]");
     if (!(p->k == 0.0 || invertible(p->k)))
         return contact_reject(msg, len, "k", p->k,
-                      "the Hertz constant must be positive, finite and not denormal, or 0 to derive it from R, "
-                      "E_i, nu_i, E_s, nu_s [N/m^1.5]");
+                      "the spring constant must be positive, finite and not denormal, or 0 to derive the Hertz "
+                      "constant from R, E_i, nu_i, E_s, nu_s [N/m^n]");
+    if (!(isfinite(p->spring_exponent) && p->spring_exponent >= 1.0 && p->spring_exponent <= 10.0))
+        return contact_reject(msg, len, "spring_exponent", p->spring_exponent,
+                      "the spring exponent n must lie in [1, 10] (1.5 Hertz sphere, 1 flat punch, 2 cone)");
+    if (p->k == 0.0 && p->spring_exponent != 1.5) {
+        char text[32];
+        snprintf(msg, len,
+                 "k = 0 is invalid with spring_exponent = %s: deriving k from R, E_i, nu_i, E_s, nu_s gives the "
+                 "Hertz constant of a sphere, n = 1.5; give k for any other n",
+                 shown(p->spring_exponent, text));
+        return -1;
+    }
     if (p->k == 0.0 && !invertible(hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s)))
         return contact_reject(msg, len, "k", p->k,
                       "the Hertz constant derived from R, E_i, nu_i, E_s, nu_s is out of range (zero, denormal or "
@@ -112,6 +138,30 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return contact_reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
     if (p->scheme != CONTACT_SCHEME_SDIRK2 && p->scheme != CONTACT_SCHEME_CENTRAL)
         return contact_reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
+    if (p->damper != CONTACT_DAMPER_DASHPOT && p->damper != CONTACT_DAMPER_SPRINGPOT)
+        return contact_reject(msg, len, "damper", p->damper, "1 = dashpot, 2 = springpot");
+    if (!(p->damper_order > 0.0 && p->damper_order <= 1.0))
+        return contact_reject(msg, len, "damper_order", p->damper_order,
+                              "the springpot's order alpha must lie in (0, 1] (1: a dashpot)");
+    if (!invertible(p->c_alpha))
+        return contact_reject(msg, len, "c_alpha", p->c_alpha,
+                              "the springpot constant must be positive, finite and not denormal [N s^alpha/m]");
+    if (p->memory != CONTACT_MEMORY_G1 && p->memory != CONTACT_MEMORY_COMPRESSED)
+        return contact_reject(msg, len, "memory", p->memory, "1 = full G1 history, 2 = compressed (sum of exponentials)");
+    if (!(p->memory_tolerance >= 1e-13 && p->memory_tolerance <= 1e-2))
+        return contact_reject(msg, len, "memory_tolerance", p->memory_tolerance,
+                              "the compressed memory's kernel tolerance must lie in [1e-13, 1e-2]");
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->scheme == CONTACT_SCHEME_CENTRAL)
+        return contact_reject(msg, len, "scheme", p->scheme,
+                              "the central differences (2) drive the dashpot only; the springpot (damper = 2) needs 1");
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_COMPRESSED) {
+        double a[CONTACT_MAX_MODES], b[CONTACT_MAX_MODES], eta;
+        if (soe_kernel(p->damper_order, p->memory_tolerance, p->dt_max, CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, a, b,
+                       &eta) > CONTACT_MAX_MODES)
+            return contact_reject(msg, len, "memory_tolerance", p->memory_tolerance,
+                                  "the compressed memory would need more than 160 modes with this dt_max: "
+                                  "loosen the tolerance or raise dt_max");
+    }
     return 0;
 }
 
@@ -164,26 +214,53 @@ int contact_check_striker(const contact_params *p, int scene, double v, double m
      * power of a dashpot driven at the rate v. */
     if (m > 0.0 && !isfinite(0.5 * m * v * v))
         return contact_reject(msg, len, "v", v, "the striker's kinetic energy m v^2 / 2 exceeds double precision");
-    if (m > 0.0 && !isfinite(m * p->g * (m * p->g) / p->c))
+    if (p->damper == CONTACT_DAMPER_DASHPOT && m > 0.0 && !isfinite(m * p->g * (m * p->g) / p->c))
         return contact_reject(msg, len, "g", p->g, "the power (m g)^2 / c its weight can dissipate exceeds double precision");
-    if (m == 0.0 && !isfinite(p->c * v * v))
+    if (p->damper == CONTACT_DAMPER_DASHPOT && m == 0.0 && !isfinite(p->c * v * v))
         return contact_reject(msg, len, "v", v, "the power c v^2 of the dashpot driven at v exceeds double precision");
     return 0;
 }
 
-/* The G1 ratio of the law on N intervals (MODEL.md §4). */
-static double g1_ratio(int law, double N)
+/* The G1 ratio of the law on N intervals for x1^n = Gamma(n+1) D^(-(n-1)) x1
+ * (MODEL.md §4, §7): Gamma(N+n)/(Gamma(N) N^n). */
+static double g1_ratio(int law, double n, double N)
 {
-    return law == CONTACT_LAW_G1 ? g1_line_ratio(-0.5, N) : g1_line_ratio_extrapolated(-0.5, N);
+    return law == CONTACT_LAW_G1 ? g1_line_ratio(1.0 - n, N) : g1_line_ratio_extrapolated(1.0 - n, N);
+}
+
+static int springpot(const contact_model *cm) { return cm->p.damper == CONTACT_DAMPER_SPRINGPOT; }
+
+static int compressed_memory(const contact_model *cm)
+{
+    return springpot(cm) && cm->p.memory == CONTACT_MEMORY_COMPRESSED;
+}
+
+static int full_history(const contact_model *cm)
+{
+    return springpot(cm) && cm->p.memory == CONTACT_MEMORY_G1;
 }
 
 void contact_configure(contact_model *cm, const contact_params *p)
 {
+    const double n = p->spring_exponent;
     cm->p = *p;
     cm->k = p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
+    cm->n_gamma = n == 1.5 ? GAMMA_5_2 : tgamma(n + 1.0);
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
-                  : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, (double)p->g1_nodes) : 0.0;
+                  : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
+    cm->modes.modes = 0;
+    cm->modes.h = 0.0;
+    if (compressed_memory(cm))
+        cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, p->dt_max, CONTACT_MEMORY_SPAN,
+                                     CONTACT_MAX_MODES, cm->modes.a, cm->modes.b, &cm->modes.eta);
+}
+
+void contact_release(contact_model *cm)
+{
+    free(cm->history.x2);
+    free(cm->history.w);
+    memset(&cm->history, 0, sizeof cm->history);
 }
 
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
@@ -209,24 +286,37 @@ void contact_drive(contact_model *cm, double v, double m, double slope)
     cm->accel = m > 0.0 ? cm->p.g : slope;
 }
 
+/* The spring force K x1^n at x1 > 0 (the Hertz sphere's n = 1.5 without pow). */
+static double spring_force(const contact_model *cm, double K, double x1)
+{
+    const double n = cm->p.spring_exponent;
+    return n == 1.5 ? K * x1 * sqrt(x1) : n == 1.0 ? K * x1 : K * pow(x1, n);
+}
+
+double contact_damper_rate(const contact_model *cm)
+{
+    return springpot(cm) ? cm->s.x2_rate : cm->s.F * cm->inv_c;
+}
+
 void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate)
 {
     const contact_state *s = &cm->s;
+    const double n = cm->p.spring_exponent;
     double x1 = contact_elastic_indentation(cm);
-    *x1_rate = s->in_contact ? s->v - s->F * cm->inv_c : 0.0;
+    *x1_rate = s->in_contact ? s->v - contact_damper_rate(cm) : 0.0;
     *v_rate = cm->accel - cm->inv_m * s->F;
-    *F_rate = x1 > 0.0 ? 1.5 * contact_spring_stiffness(cm, s->n) * sqrt(x1) * *x1_rate : 0.0;
+    *F_rate = x1 > 0.0 ? n * contact_spring_stiffness(cm, s->n) * pow(x1, n - 1.0) * *x1_rate : 0.0;
 }
 
 double contact_spring_stiffness(const contact_model *cm, long n_steps)
 {
     if (cm->p.law == CONTACT_LAW_HERTZ || cm->p.g1_nodes > 0)
         return cm->k_fixed;
-    return n_steps > 0 ? cm->k * g1_ratio(cm->p.law, (double)n_steps) : cm->k;
+    return n_steps > 0 ? cm->k * g1_ratio(cm->p.law, cm->p.spring_exponent, (double)n_steps) : cm->k;
 }
 
 /* The root s > 0 of s^2 + beta s^3 = r (r > 0, beta >= 0): s^2 is the elastic
- * indentation of an implicit stage. With u = beta sqrt(r) the root is
+ * indentation of an implicit stage with n = 3/2. With u = beta sqrt(r) the root is
  *     sqrt(r) (1 - u/2 + 5u^2/8 - u^3 + 231u^4/128 - 3.5u^5 + ...),
  * so for u < 1e-4 (every step at the paper's parameters: u ~ 3e-5) the
  * series to u^4 is exact to 4e-20, below rounding. Otherwise Newton's
@@ -252,38 +342,162 @@ static double stage_root(double r, double beta)
     return s;
 }
 
-/* One implicit stage of x1' = v - F/c, v' = accel - inv_m F with
- * F = K max(x1, 0)^(3/2):  X = xh + hg (V - F/c),  V = vh + hg (accel - inv_m F).
- * Eliminating V leaves X + beta X^(3/2) = r, one scalar root. Returns F. */
-static double implicit_stage(const contact_model *cm, double K, double hg,
-                             double xh, double vh, double *X, double *V)
+/* The root X > 0 of X + beta X^n = r (r > 0, beta >= 0, n >= 1) for any n:
+ * Newton's method from the smaller of r and (r/beta)^(1/n), both at or above
+ * the root, where the increasing convex function converges monotonically. */
+static double power_root(double r, double beta, double n)
 {
-    double r = xh + hg * (vh + hg * cm->accel);
-    double F = 0.0;
-    if (r > 0.0 && K > 0.0) {
-        double s = stage_root(r, K * hg * (cm->inv_c + hg * cm->inv_m));
-        *X = s * s;
-        F = K * s * s * s;
-    } else {
-        *X = r; /* out of contact the striker moves freely */
+    double X = beta > 0.0 ? fmin(r, pow(r / beta, 1.0 / n)) : r, dX;
+    int i;
+    for (i = 0; i < 200; i++) {
+        double Xn1 = pow(X, n - 1.0);
+        dX = (X + beta * X * Xn1 - r) / (1.0 + n * beta * Xn1);
+        X -= dX;
+        if (!(fabs(dX) > 1e-9 * X))
+            break;
     }
+    return X;
+}
+
+/* The elastic indentation X of an implicit stage, X + beta X^n = r, and the
+ * spring force K X^n there. */
+static double stage_force(const contact_model *cm, double K, double r, double beta, double *X)
+{
+    const double n = cm->p.spring_exponent;
+    if (n == 1.5) {
+        double s = stage_root(r, beta);
+        *X = s * s;
+        return K * s * s * s;
+    }
+    *X = n == 1.0 ? r / (1.0 + beta) : power_root(r, beta, n);
+    return spring_force(cm, K, *X);
+}
+
+/* What the damper makes of an implicit stage: its rate x2' = (F - A) inv_B,
+ * linear in the force (the dashpot: A = 0, inv_B = 1/c; a springpot: its
+ * memory's pull A and its stiffness over the stage as a viscosity 1/inv_B). */
+typedef struct {
+    double A, inv_B;
+} damper_stage;
+
+/* One implicit stage of x1' = v - x2', v' = accel - inv_m F with
+ * F = K max(x1, 0)^n, x2' = (F - A) inv_B:
+ *     X = xh + hg (V - x2'),  V = vh + hg (accel - inv_m F).
+ * Eliminating V and x2' leaves X + beta X^n = r, one scalar root. Returns F. */
+static double implicit_stage(const contact_model *cm, double K, double hg, double xh, double vh,
+                             const damper_stage *d, double *X, double *V)
+{
+    double r = xh + hg * (vh + hg * cm->accel) + hg * d->A * d->inv_B;
+    double F = 0.0;
+    if (r > 0.0 && K > 0.0)
+        F = stage_force(cm, K, r, K * hg * (d->inv_B + hg * cm->inv_m), X);
+    else
+        *X = r; /* out of contact the striker moves freely */
     *V = vh + hg * (cm->accel - cm->inv_m * F);
     return F;
 }
 
-/* One SDIRK step of length h from *in with spring stiffness K (0: free
- * flight, where the step is exact). Writes t, x1, x2, v, F, E_diss of *out;
- * returns the impulse of the contact force over the step. */
-static double sdirk_step(const contact_model *cm, const contact_state *in, double h,
-                         double K, contact_state *out)
+/* ------------------------------------------------- the compressed memory */
+
+/* The springpot F = c_alpha (eta x2' + sum_i a_i phi_i), phi_i' = -b_i phi_i
+ * + x2' (MODEL.md §8), in the SDIRK stages of a step of length h: with
+ * d_i = 1/(1 + gamma h b_i) each stage's modes are d_i (their explicit part
+ * + gamma h x2'), so the force is linear in x2' with the coefficients below,
+ * which depend on h alone and are kept for the step length last used. */
+static const contact_modes *modes_for_step(contact_model *cm, double h)
+{
+    contact_modes *m = &cm->modes;
+    const double hg = SDIRK_GAMMA * h, hb = (1.0 - SDIRK_GAMMA) * h;
+    size_t i;
+    if (m->h == h)
+        return m;
+    m->sum_p = m->sum_q = 0.0;
+    for (i = 0; i < m->modes; i++) {
+        double d = 1.0 / (1.0 + hg * m->b[i]);
+        m->p[i] = m->a[i] * d;
+        m->q[i] = m->p[i] * d * m->b[i];
+        m->sum_p += m->p[i];
+        m->sum_q += m->q[i];
+        /* phi_new = keep phi + rate1 x2'_1 + rate2 x2'_2 over the step */
+        m->keep[i] = d * (1.0 - hb * m->b[i] * d);
+        m->rate1[i] = d * d * hb;
+        m->rate2[i] = d * hg;
+    }
+    m->h = h;
+    return m;
+}
+
+/* The two stages' damper terms of a springpot step from the modes phi:
+ * stage 1 from sum p phi; stage 2, after the first stage's rate z1, from the
+ * modes advanced explicitly by (1 - gamma) h. */
+static void springpot_stages(contact_model *cm, double h, damper_stage *d1, double *S2)
+{
+    const contact_modes *m = modes_for_step(cm, h);
+    const double c = cm->p.c_alpha;
+    double S1 = 0.0, Sq = 0.0;
+    size_t i;
+    for (i = 0; i < m->modes; i++) {
+        S1 += m->p[i] * m->phi[i];
+        Sq += m->q[i] * m->phi[i];
+    }
+    d1->A = c * S1;
+    d1->inv_B = 1.0 / (c * (m->eta + SDIRK_GAMMA * h * m->sum_p));
+    *S2 = Sq;
+}
+
+static void springpot_second_stage(const contact_model *cm, double h, const damper_stage *d1, double Sq, double z1,
+                                   damper_stage *d2)
+{
+    const contact_modes *m = &cm->modes;
+    const double hg = SDIRK_GAMMA * h, hb = (1.0 - SDIRK_GAMMA) * h;
+    d2->A = d1->A + cm->p.c_alpha * hb * (z1 * m->sum_p - (Sq + hg * z1 * m->sum_q));
+    d2->inv_B = d1->inv_B;
+}
+
+/* The modes after an accepted step of length h with stage rates z1, z2. */
+static void advance_modes(contact_model *cm, double h, double z1, double z2)
+{
+    const contact_modes *m = modes_for_step(cm, h);
+    size_t i;
+    for (i = 0; i < m->modes; i++)
+        cm->modes.phi[i] = m->keep[i] * m->phi[i] + m->rate1[i] * z1 + m->rate2[i] * z2;
+}
+
+/* Whether the springpot holds no memory: before its first contact. */
+static int memory_at_rest(const contact_model *cm)
+{
+    size_t i;
+    if (!springpot(cm))
+        return 1;
+    if (cm->s.x2 != 0.0 || cm->s.x2_rate != 0.0)
+        return 0;
+    for (i = 0; i < cm->modes.modes; i++)
+        if (cm->modes.phi[i] != 0.0)
+            return 0;
+    return 1;
+}
+
+/* ---------------------------------------------------------- SDIRK steps */
+
+/* One SDIRK step of length h from *in with spring stiffness K (0: no
+ * contact: free flight, exact while the damper rests). Writes t, x1, x2, v,
+ * F, E_diss and what accepting the step needs (its length and the damper's
+ * stage rates) of *out; returns the impulse of the contact force. */
+static double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
     const double hg = SDIRK_GAMMA * h, hb = (1.0 - SDIRK_GAMMA) * h;
-    const double inv_c = cm->inv_c;
-    double X1, V1, X2, V2, F1, F2, impulse;
+    damper_stage d1 = {0.0, cm->inv_c}, d2 = {0.0, cm->inv_c};
+    double X1, V1, X2, V2, F1, F2, z1, z2, impulse, Sq = 0.0;
 
-    F1 = implicit_stage(cm, K, hg, in->x1, in->v, &X1, &V1);
-    F2 = implicit_stage(cm, K, hg, in->x1 + hb * (V1 - F1 * inv_c),
-                        in->v + hb * (cm->accel - cm->inv_m * F1), &X2, &V2);
+    if (compressed_memory(cm))
+        springpot_stages(cm, h, &d1, &Sq);
+    F1 = implicit_stage(cm, K, hg, in->x1, in->v, &d1, &X1, &V1);
+    z1 = (F1 - d1.A) * d1.inv_B;
+    if (compressed_memory(cm))
+        springpot_second_stage(cm, h, &d1, Sq, z1, &d2);
+    F2 = implicit_stage(cm, K, hg, in->x1 + hb * (V1 - z1), in->v + hb * (cm->accel - cm->inv_m * F1), &d2, &X2,
+                        &V2);
+    z2 = (F2 - d2.A) * d2.inv_B;
     impulse = hb * F1 + hg * F2;
 
     *out = *in;
@@ -291,14 +505,30 @@ static double sdirk_step(const contact_model *cm, const contact_state *in, doubl
     out->x1 = X2;
     out->v = V2;
     out->F = F2;
+    out->step = h;
+    out->x2_rate1 = z1;
+    out->x2_rate = z2;
+    if (springpot(cm)) {
+        out->x2 = in->x2 + hb * z1 + hg * z2;
+        out->E_diss = in->E_diss + hb * F1 * z1 + hg * F2 * z2;
+        return impulse;
+    }
     /* The dashpot carries the spring's force: x2' = F/c, dissipating F^2/c.
      * A step counts J^2/(c h), the dissipation of its mean force J/h: within
      * O(h^3) of the integral (which exceeds it by h Var(F)/c), and unlike a
      * quadrature of the stage forces it does not overshoot the energy there
      * is when a step is far too long to resolve the motion. */
-    out->x2 = in->x2 + impulse * inv_c;
-    out->E_diss = in->E_diss + (h > 0.0 ? impulse * impulse * inv_c / h : 0.0);
+    out->x2 = in->x2 + impulse * cm->inv_c;
+    out->E_diss = in->E_diss + (h > 0.0 ? impulse * impulse * cm->inv_c / h : 0.0);
     return impulse;
+}
+
+/* Makes a trial step the model's state, and its memory follow. */
+static void accept_step(contact_model *cm, const contact_state *trial)
+{
+    if (compressed_memory(cm))
+        advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
+    cm->s = *trial;
 }
 
 static void begin_contact(contact_state *s, double t, double v);
@@ -331,23 +561,29 @@ static double flight_onset(double x1, double v, double a, double h)
     return fmin(fmax(t, 0.0), h);
 }
 
-/* Free flight for tau, exact (the step with no spring), then contact begins
- * if `touch`. */
-static void fly(contact_model *cm, double tau, int touch)
+/* Contact begins where the model's state is. */
+static void touch(contact_model *cm)
+{
+    cm->s.x1 = 0.0;
+    cm->s.F = 0.0;
+    begin_contact(&cm->s, cm->s.t, cm->s.v);
+}
+
+/* Free flight for tau while the damper rests, exact (the step with no
+ * spring), then contact begins if `touches`. */
+static void fly(contact_model *cm, double tau, int touches)
 {
     contact_state trial;
     sdirk_step(cm, &cm->s, tau, 0.0, &trial);
-    cm->s = trial;
-    if (touch) {
-        cm->s.x1 = 0.0;
-        cm->s.F = 0.0;
-        begin_contact(&cm->s, cm->s.t, cm->s.v);
-    }
+    accept_step(cm, &trial);
+    if (touches)
+        touch(cm);
 }
 
 /* What an event watches at the end of a trial step: the elastic indentation
- * x1 (it reaches 0 at separation) or its rate x1' = v - F/c (it reaches 0
- * where x1, and with it the force, peaks). */
+ * x1 (it reaches 0 at separation), the gap -x1 (it reaches 0 at onset), or
+ * the indentation rate x1' = v - x2' (it reaches 0 where x1, and with it the
+ * force, peaks). */
 typedef double (*event_value)(const contact_model *cm, const contact_state *s);
 
 static double indentation(const contact_model *cm, const contact_state *s)
@@ -356,18 +592,23 @@ static double indentation(const contact_model *cm, const contact_state *s)
     return s->x1;
 }
 
-static double indentation_rate(const contact_model *cm, const contact_state *s)
+static double gap(const contact_model *cm, const contact_state *s)
 {
-    return s->v - s->F * cm->inv_c;
+    (void)cm;
+    return -s->x1;
 }
 
-/* The length tau in (0, h] of a contact step from *s at which the event
- * value falls to 0, given that it is > 0 at the start and f_end <= 0 after
- * the full step: Illinois regula falsi on the value at the step's end, which
- * is continuous in tau. Returns a tau where it is <= 0, and that step's state
- * in *at. */
-static double event_time(const contact_model *cm, const contact_state *s, double h, double K,
-                         event_value event, double f_end, contact_state *at)
+static double indentation_rate(const contact_model *cm, const contact_state *s)
+{
+    return s->v - (springpot(cm) ? s->x2_rate : s->F * cm->inv_c);
+}
+
+/* The length tau in (0, h] of a step from *s at which the event value falls
+ * to 0, given that it is > 0 at the start and f_end <= 0 after the full step:
+ * Illinois regula falsi on the value at the step's end, which is continuous
+ * in tau. Returns a tau where it is <= 0, and that step's state in *at. */
+static double event_time(contact_model *cm, const contact_state *s, double h, double K, event_value event,
+                         double f_end, contact_state *at)
 {
     double lo = 0.0, hi = h, flo = event(cm, s), fhi = f_end;
     int i, side = 0;
@@ -400,7 +641,7 @@ static double event_time(const contact_model *cm, const contact_state *s, double
 /* The force's peak inside a contact step from *s to *end, if the
  * indentation turns there: sampling the peak at step ends alone would err by
  * O(h^2) of the force's curvature, more than the scheme itself. */
-static double peak_force_within(const contact_model *cm, const contact_state *s, double h, double K,
+static double peak_force_within(contact_model *cm, const contact_state *s, double h, double K,
                                 const contact_state *end)
 {
     contact_state at;
@@ -431,14 +672,33 @@ static void end_contact(contact_state *s, double t, double v)
     s->in_contact = 0;
 }
 
-static void accept_contact_step(contact_state *s, const contact_state *trial, double peak)
+/* The contact's counters after a step whose largest force was `peak`. */
+static void count_contact_step(contact_state *s, double peak)
 {
-    *s = *trial;
     s->n++;
     if (peak > s->F_peak_contact)
         s->F_peak_contact = peak;
     if (peak > s->F_peak)
         s->F_peak = peak;
+}
+
+/* Out of contact for up to h while a springpot's dent recovers: an SDIRK
+ * step with no spring, cut at the onset if the striker meets the surface.
+ * Returns the length stepped, and whether contact began. */
+static double recover(contact_model *cm, double h, int *touches)
+{
+    contact_state trial;
+    sdirk_step(cm, &cm->s, h, 0.0, &trial);
+    *touches = trial.x1 > 0.0;
+    if (*touches && cm->s.x1 < 0.0)
+        h = event_time(cm, &cm->s, h, 0.0, gap, -trial.x1, &trial);
+    else if (*touches) /* it starts on the surface: contact at once */
+        h = 0.0;
+    if (h > 0.0)
+        accept_step(cm, &trial);
+    if (*touches)
+        touch(cm);
+    return h;
 }
 
 /* One SDIRK step of length h, split at contact onset and separation.
@@ -451,11 +711,16 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
     int events;
     for (events = 0; events < MAX_EVENTS_PER_STEP; events++) {
         double tau = h, K, J, peak;
-        int separates;
+        int separates, touches;
         if (!s->in_contact) {
-            tau = flight_onset(s->x1, s->v, cm->accel, h);
-            fly(cm, tau < 0.0 ? h : tau, tau >= 0.0);
-            if (tau < 0.0)
+            if (memory_at_rest(cm)) {
+                tau = flight_onset(s->x1, s->v, cm->accel, h);
+                touches = tau >= 0.0;
+                fly(cm, touches ? tau : h, touches);
+            } else {
+                tau = recover(cm, h, &touches);
+            }
+            if (!touches)
                 return 0;
             if (stop_at & CONTACT_ONSET)
                 return 1;
@@ -472,7 +737,8 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
             J = sdirk_step(cm, s, tau, K, &trial);
         }
         peak = peak_force_within(cm, s, tau, K, &trial);
-        accept_contact_step(s, &trial, peak);
+        accept_step(cm, &trial);
+        count_contact_step(s, peak);
         *impulse += J;
         if (!separates)
             return 0;
@@ -484,6 +750,114 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
     }
     return -1;
 }
+
+/* ------------------------------------------------- the full G1 history */
+
+/* Room for x2 at `count` grid points, growing geometrically; 0, or -1 when
+ * memory runs out (the history as it was). */
+static int history_reserve(contact_history *hist, size_t count)
+{
+    size_t capacity = hist->capacity ? hist->capacity : 1024;
+    double *x2, *w;
+    if (count <= hist->capacity)
+        return 0;
+    while (capacity < count)
+        capacity *= 2;
+    /* New blocks before the old ones go, so that a failure changes nothing. */
+    x2 = malloc(capacity * sizeof *x2);
+    w = malloc(capacity * sizeof *w);
+    if (!x2 || !w) {
+        free(x2);
+        free(w);
+        return -1;
+    }
+    if (hist->capacity)
+        memcpy(x2, hist->x2, hist->capacity * sizeof *x2);
+    free(hist->x2);
+    free(hist->w);
+    hist->x2 = x2;
+    hist->w = w;
+    hist->capacity = capacity;
+    hist->weights = 0;
+    return 0;
+}
+
+/* Contact's onset and end after a grid step from *before (x1 crossed 0 at
+ * the fraction of the step where its linear interpolation does). */
+static int g1_contact_events(contact_model *cm, const contact_state *before, unsigned stop_at)
+{
+    contact_state *s = &cm->s;
+    const double frac = before->x1 / (before->x1 - s->x1), h = s->t - before->t;
+    const double t = before->t + frac * h, v = before->v + frac * (s->v - before->v);
+    if (!before->in_contact && s->F > 0.0)
+        begin_contact(s, t, v);
+    if (s->F > 0.0)
+        count_contact_step(s, s->F);
+    if (before->in_contact && !(s->F > 0.0))
+        end_contact(s, t, v);
+    if (s->in_contact == before->in_contact && s->impacts == before->impacts)
+        return 0;
+    return (stop_at & (s->in_contact ? CONTACT_ONSET : CONTACT_SEPARATION)) != 0;
+}
+
+/* One step of dt_max on the uniform grid from t = 0 (MODEL.md §7): the G1
+ * history sum G_j = sum_{i=0..j} w_i x2_{j-i} (times h^-alpha) is D^alpha x2
+ * at t_j - alpha h/2 to O(h^2), so (1 + alpha/2) G_j - (alpha/2) G_{j-1} is
+ * D^alpha x2 at t_j to O(h^2); with BDF2 for the striker (backward Euler on
+ * the first step) the step is second order and L-stable, and at alpha = 1
+ * it is BDF2 throughout. The damper's relation is linear in F_j, as in a
+ * stage. Contact begins and ends at a step (no step is split), its times
+ * interpolated linearly. 0, 1 after an event of the mask stop_at, or -1
+ * when memory runs out. */
+static int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
+{
+    contact_state *s = &cm->s;
+    contact_history *hist = &cm->history;
+    const double h = cm->p.dt_max, alpha = cm->p.damper_order, c = cm->p.c_alpha;
+    const size_t j = (size_t)s->steps; /* the new grid point; s->steps counts this step already */
+    const contact_state before = *s;
+    const int bdf2 = j >= 2;
+    const double lead = bdf2 ? 1.0 + 0.5 * alpha : 1.0, hg = bdf2 ? 2.0 * h / 3.0 : h;
+    const double x = s->x1 + s->x2;
+    damper_stage d;
+    double X, V, F, past, mu, nu, x_h, v_h;
+    if (j > CONTACT_G1_HISTORY_MAX || history_reserve(hist, j + 1) != 0)
+        return -1;
+    if (hist->weights < j + 1 || hist->w_alpha != alpha) {
+        g1_weights(alpha, hist->capacity, hist->w);
+        hist->weights = hist->capacity;
+        hist->w_alpha = alpha;
+    }
+    if (j == 1)
+        hist->x2[0] = 0.0;
+    hist->x2[j] = 0.0; /* so that the sum below is the past's part of G_j */
+    past = pow(h, alpha) * g1_history_sum(alpha, hist->w, hist->x2, j + 1, h);
+    /* lead (x2_j + past) - (lead - 1) G_{j-1} = h^alpha F / c_alpha:
+     * x2_j = mu F + nu, which a stage takes as A = -nu/mu, inv_B = mu/hg. */
+    mu = pow(h, alpha) / (c * lead);
+    nu = (lead - 1.0) * hist->G_prev / lead - past;
+    x_h = bdf2 ? (4.0 * x - s->x_prev) / 3.0 : x;
+    v_h = bdf2 ? (4.0 * s->v - hist->v_prev) / 3.0 : s->v;
+    d.inv_B = mu / hg;
+    d.A = -nu / mu;
+    F = implicit_stage(cm, contact_spring_stiffness(cm, s->in_contact ? s->n + 1 : 1), hg, x_h, v_h, &d, &X, &V);
+    s->x_prev = x;
+    hist->v_prev = s->v;
+    s->t += h;
+    s->x1 = X;
+    s->v = V;
+    s->x2 = mu * F + nu;
+    s->x2_rate = (s->x2 - before.x2) / h;
+    s->step = h;
+    s->F = F;
+    s->E_diss += 0.5 * (F + before.F) * (s->x2 - before.x2);
+    hist->x2[j] = s->x2;
+    hist->G_prev = s->x2 + past;
+    *impulse += 0.5 * h * (F + before.F);
+    return g1_contact_events(cm, &before, stop_at);
+}
+
+/* ------------------------------------------------ the paper's scheme */
 
 /* The paper's explicit scheme (MODEL.md §5), kept for comparison: x'' by
  * central differences (Stormer), the dashpot x2' = F/c by forward Euler with
@@ -511,7 +885,7 @@ static void central_internal_step(contact_model *cm, double h, double *impulse)
     s->t = t + h;
     if (s->in_contact) {
         s->n++;
-        s->F = x1_next > 0.0 ? contact_spring_stiffness(cm, s->n) * x1_next * sqrt(x1_next) : 0.0;
+        s->F = x1_next > 0.0 ? spring_force(cm, contact_spring_stiffness(cm, s->n), x1_next) : 0.0;
     }
     if (cm->inv_m > 0.0) /* second-order velocity at the step's end */
         s->v = (x_next - x) / h + 0.5 * h * (cm->accel - cm->inv_m * s->F);
@@ -529,6 +903,8 @@ static int internal_step(contact_model *cm, double h, double *impulse, unsigned 
 {
     int was_in_contact = cm->s.in_contact;
     cm->s.steps++;
+    if (full_history(cm))
+        return g1_history_step(cm, impulse, stop_at);
     if (cm->p.scheme == CONTACT_SCHEME_CENTRAL) {
         central_internal_step(cm, h, impulse);
         return cm->s.in_contact != was_in_contact
@@ -537,13 +913,54 @@ static int internal_step(contact_model *cm, double h, double *impulse, unsigned 
     return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
-static int state_is_finite(const contact_state *s)
+static int state_is_finite(const contact_model *cm)
 {
-#define FINITE(field) && isfinite(s->field)
+    const contact_state *s = &cm->s;
+    size_t i;
+#define FINITE(field) &&isfinite(s->field)
 #define ALWAYS_FINITE(field)
-    return 1 CONTACT_STATE_FIELDS(FINITE, ALWAYS_FINITE, ALWAYS_FINITE);
+    if (!(1 CONTACT_STATE_FIELDS(FINITE, ALWAYS_FINITE, ALWAYS_FINITE) && isfinite(s->x2_rate)))
+        return 0;
 #undef FINITE
 #undef ALWAYS_FINITE
+    for (i = 0; i < cm->modes.modes; i++)
+        if (!isfinite(cm->modes.phi[i]))
+            return 0;
+    return 1;
+}
+
+int contact_steps_uniformly(const contact_model *cm)
+{
+    return cm->p.scheme == CONTACT_SCHEME_CENTRAL || full_history(cm);
+}
+
+int contact_check_advance(const contact_model *cm, double H, char *msg, size_t len)
+{
+    double steps = H / cm->p.dt_max, whole = floor(steps + 0.5);
+    if (!full_history(cm))
+        return 0;
+    if (fabs(steps - whole) > 1e-9 * fmax(1.0, whole)) {
+        snprintf(msg, len,
+                 "memory = 1 (the full G1 history) steps on a uniform grid of dt_max = %.17g s: an advance by "
+                 "%.17g s is not a whole number of its steps (use memory = 2 for any step)",
+                 cm->p.dt_max, H);
+        return -1;
+    }
+    if ((double)cm->s.steps + whole > (double)CONTACT_G1_HISTORY_MAX) {
+        snprintf(msg, len,
+                 "memory = 1 (the full G1 history) keeps every step of the run, at most %d (t = %.17g s at "
+                 "dt_max = %g s); use memory = 2, whose memory does not grow",
+                 CONTACT_G1_HISTORY_MAX, CONTACT_G1_HISTORY_MAX * cm->p.dt_max, cm->p.dt_max);
+        return -1;
+    }
+    return 0;
+}
+
+/* The next step out of contact while a springpot's memory relaxes. */
+static double recovery_step(const contact_model *cm, double remaining)
+{
+    const double since = cm->s.impacts > 0 ? cm->s.t - (cm->s.t_onset + cm->s.t_contact) : 0.0;
+    return fmin(remaining, fmax(cm->p.dt_max, RECOVERY_STEP_FRACTION * since));
 }
 
 double contact_advance(contact_model *cm, double H)
@@ -554,20 +971,33 @@ double contact_advance(contact_model *cm, double H)
 double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
 {
     const contact_state start = cm->s;
+    double phi_start[CONTACT_MAX_MODES];
     double remaining = H, impulse = 0.0;
-    int stopped = 0;
+    int stopped = 0, failed = 0, uniform = contact_steps_uniformly(cm);
     if (!(H > 0.0))
         return 0.0;
-    while (remaining > 0.0 && !stopped) {
+    if (compressed_memory(cm))
+        memcpy(phi_start, cm->modes.phi, cm->modes.modes * sizeof *phi_start);
+    while (remaining > 0.0 && !stopped && !failed) {
         double n, h, i;
-        if (!cm->s.in_contact && cm->p.scheme == CONTACT_SCHEME_SDIRK2) {
-            /* Free flight is exact at any length: one step to the onset, or
-             * over the whole rest when the striker does not arrive. */
-            double tau = flight_onset(cm->s.x1, cm->s.v, cm->accel, remaining);
+        if (!cm->s.in_contact && !uniform) {
+            /* Free flight is exact at any length while the damper rests: one
+             * step to the onset, or over the whole rest when the striker does
+             * not arrive; a recovering springpot takes growing steps. */
+            double tau;
+            int touches;
             cm->s.steps++;
-            fly(cm, tau < 0.0 ? remaining : tau, tau >= 0.0);
-            remaining = tau < 0.0 ? 0.0 : remaining - tau;
-            stopped = tau >= 0.0 && (stop_at & CONTACT_ONSET);
+            if (memory_at_rest(cm)) {
+                tau = flight_onset(cm->s.x1, cm->s.v, cm->accel, remaining);
+                touches = tau >= 0.0;
+                if (!touches)
+                    tau = remaining;
+                fly(cm, tau, touches);
+            } else {
+                tau = recover(cm, recovery_step(cm, remaining), &touches);
+            }
+            remaining -= tau;
+            stopped = touches && (stop_at & CONTACT_ONSET);
             continue;
         }
         /* In contact: equal steps of at most dt_max over the rest, rounding
@@ -575,20 +1005,19 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
          * not n + 1 with a sliver), until the contact ends. */
         n = fmax(1.0, ceil(remaining / cm->p.dt_max * (1.0 - 1e-12)));
         h = remaining / n;
-        for (i = 0; i < n && !stopped && (cm->s.in_contact || cm->p.scheme == CONTACT_SCHEME_CENTRAL); i++) {
+        for (i = 0; i < n && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
             int status = internal_step(cm, h, &impulse, stop_at);
-            if (status < 0) {
-                cm->s = start;
-                return NAN;
-            }
-            stopped = status;
+            failed = status < 0;
+            stopped = status > 0;
         }
         remaining = i < n ? remaining - i * h : 0.0;
     }
     /* A non-finite value stays non-finite through the steps that follow
      * (and bounds their event searches), so one check at the end suffices. */
-    if (!state_is_finite(&cm->s)) {
+    if (failed || !state_is_finite(cm)) {
         cm->s = start;
+        if (compressed_memory(cm))
+            memcpy(cm->modes.phi, phi_start, cm->modes.modes * sizeof *phi_start);
         return NAN;
     }
     if (!stopped)
@@ -601,6 +1030,10 @@ int contact_never_returns(const contact_model *cm)
     const contact_state *s = &cm->s;
     const double a = cm->accel;
     if (s->in_contact || a > 0.0)
+        return 0;
+    /* A recovering dent (x2 falls towards 0, never below) may still meet a
+     * striker that has not cleared the undeformed surface. */
+    if (!memory_at_rest(cm) && !(s->v <= 0.0 && s->x1 + s->x2 <= 0.0))
         return 0;
     if (s->v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
         return a < 0.0 && !(s->x1 + 0.5 * s->v * s->v / -a > 0.0);
@@ -619,10 +1052,63 @@ double contact_total_indentation(const contact_model *cm)
 
 double contact_semi_integral_per_force(const contact_model *cm)
 {
-    return 1.0 / (GAMMA_5_2 * cm->k);
+    return 1.0 / (cm->n_gamma * cm->k);
 }
 
 double contact_semi_integral(const contact_model *cm)
 {
     return cm->s.F * contact_semi_integral_per_force(cm);
+}
+
+/* ------------------------------------------------ the memory as values */
+
+size_t contact_memory_count(const contact_model *cm)
+{
+    if (compressed_memory(cm))
+        return 1 + cm->modes.modes;
+    return full_history(cm) ? 4 + (size_t)cm->s.steps : 0;
+}
+
+double contact_memory_get(const contact_model *cm, size_t i)
+{
+    if (i == 0)
+        return cm->s.x2_rate;
+    if (compressed_memory(cm))
+        return cm->modes.phi[i - 1];
+    if (i < 3)
+        return i == 1 ? cm->history.v_prev : cm->history.G_prev;
+    return i - 3 < cm->history.capacity ? cm->history.x2[i - 3] : 0.0; /* x2(0) = 0 before the first step */
+}
+
+int contact_memory_accepts(const contact_model *cm, size_t count, char *msg, size_t len)
+{
+    size_t expected = contact_memory_count(cm);
+    if (full_history(cm) && cm->s.steps > CONTACT_G1_HISTORY_MAX) {
+        snprintf(msg, len, "a G1 history of %lld steps exceeds the limit of %d",
+                 (long long)cm->s.steps, CONTACT_G1_HISTORY_MAX);
+        return -1;
+    }
+    if (count != expected) {
+        snprintf(msg, len, "the damper's memory holds %zu values where these parameters and %lld steps need %zu",
+                 count, (long long)cm->s.steps, expected);
+        return -1;
+    }
+    return 0;
+}
+
+int contact_memory_resize(contact_model *cm, size_t count)
+{
+    return full_history(cm) && count > 3 ? history_reserve(&cm->history, count - 3) : 0;
+}
+
+void contact_memory_set(contact_model *cm, size_t i, double value)
+{
+    if (i == 0)
+        cm->s.x2_rate = value;
+    else if (compressed_memory(cm))
+        cm->modes.phi[i - 1] = value;
+    else if (i < 3)
+        *(i == 1 ? &cm->history.v_prev : &cm->history.G_prev) = value;
+    else
+        cm->history.x2[i - 3] = value;
 }

@@ -1,6 +1,8 @@
-/* The rheological contact model of MODEL.md §2 and §4: a striker pushing on a
- * Hertz spring in series with a linear dashpot. Knows nothing of FMI; the FMU
- * and the solver both drive it through this interface. C99, libc and libm. */
+/* The rheological contact model of MODEL.md §2, §4 and §7: a striker pushing
+ * on a spring k x1^n in series with a damper, a linear dashpot or a springpot
+ * c_alpha D^alpha x2 whose memory is kept either as the literal G1 history or
+ * as a sum of exponentials (soe.h). Knows nothing of FMI; the FMU and the
+ * solver both drive it through this interface. C99, libc and libm. */
 #ifndef FRACCONTACT_CONTACT_H
 #define FRACCONTACT_CONTACT_H
 
@@ -24,6 +26,25 @@ enum contact_event {
     CONTACT_SEPARATION = 2  /* the force returns to zero: an impact has ended */
 };
 
+enum contact_damper {
+    CONTACT_DAMPER_DASHPOT = 1,  /* F = c x2' */
+    CONTACT_DAMPER_SPRINGPOT = 2 /* F = c_alpha D^alpha x2 (Caputo from t = 0), MODEL.md §7 */
+};
+
+enum contact_memory {
+    CONTACT_MEMORY_G1 = 1,        /* the springpot's literal G1 history sum: uniform steps, O(N) each */
+    CONTACT_MEMORY_COMPRESSED = 2 /* a sum of exponentials: M modes, any step (MODEL.md §8) */
+};
+
+/* The compressed memory's largest number of modes, and the span over which
+ * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN. */
+#define CONTACT_MAX_MODES 160
+#define CONTACT_MEMORY_SPAN 1e3
+
+/* The full G1 history keeps x2 at every step of the run: at most this many
+ * steps (8 MiB of history, and as much for the G1 weights). */
+#define CONTACT_G1_HISTORY_MAX 1048576
+
 enum contact_scene {
     CONTACT_SCENE_DROP = 1,   /* the model owns a free striker */
     CONTACT_SCENE_DRIVEN = 2  /* the caller prescribes the indentation rate */
@@ -33,8 +54,12 @@ typedef struct {
     double R;            /* striker tip radius [m] */
     double E_i, nu_i;    /* indenter Young's modulus [Pa] and Poisson ratio */
     double E_s, nu_s;    /* specimen Young's modulus [Pa] and Poisson ratio */
-    double k;            /* Hertz constant [N/m^1.5]; 0: derive from the above */
+    double k;            /* spring constant [N/m^n]; 0: the Hertz constant from the above (n = 1.5) */
+    double spring_exponent; /* n in F = k x1^n, >= 1 */
     double c;            /* dashpot constant [N s/m] */
+    double damper_order; /* alpha of the springpot, in (0, 1] */
+    double c_alpha;      /* springpot constant [N s^alpha/m] */
+    double memory_tolerance; /* relative error of the compressed memory's kernel */
     double dt_max;       /* largest internal step [s] */
     double g;            /* acceleration of the model's striker towards the specimen [m/s^2] */
     double gap0;         /* gap between striker and specimen at the start [m] */
@@ -42,18 +67,20 @@ typedef struct {
     int g1_nodes;        /* G1 intervals N; 0: internal steps since contact onset */
     int scene;           /* enum contact_scene */
     int scheme;          /* enum contact_scheme */
+    int damper;          /* enum contact_damper */
+    int memory;          /* enum contact_memory */
 } contact_params;
 
 typedef struct {
     double t;         /* time [s] */
     double x1;        /* x - x2: the elastic (Hertz) indentation while >= 0,
                          minus the gap to the dented surface while < 0 [m] */
-    double x2;        /* permanent indentation, the dashpot's travel [m] */
+    double x2;        /* the damper's travel: the dent [m] */
     double v;         /* striker velocity towards the specimen [m/s] */
     double F;         /* contact force at the end of the last internal step [N] */
     double F_peak;    /* largest contact force so far [N] */
     double F_peak_contact; /* largest force of the current (or last) contact [N] */
-    double E_diss;    /* energy dissipated by the dashpot so far [J] */
+    double E_diss;    /* work done on the damper so far, the integral of F dx2 [J] */
     double eps;       /* restitution coefficient of the last finished impact */
     double v_onset;   /* striker velocity at the onset of the current contact */
     double t_onset;   /* time of the onset of the current (or last) contact [s] */
@@ -64,9 +91,13 @@ typedef struct {
     double h_prev;    /* and that step (0: not yet known) */
     int64_t impacts;  /* finished impacts */
     int in_contact;
+    /* Not part of the state carried from step to step (so not listed
+     * below): what a trial step leaves for accepting it, its length and
+     * the damper's rate x2' at its two stages (the second is the end's). */
+    double step, x2_rate1, x2_rate;
 } contact_state;
 
-/* Every field of contact_state, described once: DOUBLE(name) for the doubles,
+/* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,
  * INT64(name) for the counters, INT(name) for the flag. The model's check that
  * a step kept the state finite and whoever saves a state field by field
  * expand it, so that a new field reaches both or neither. */
@@ -75,14 +106,41 @@ typedef struct {
     DOUBLE(eps) DOUBLE(v_onset) DOUBLE(t_onset) DOUBLE(t_contact) DOUBLE(x_prev) DOUBLE(h_prev)            \
     INT64(n) INT64(steps) INT64(impacts) INT(in_contact)
 
+/* The compressed memory (a springpot with memory = 2): the kernel's modes,
+ * their state, and the coefficients of one step length. */
+typedef struct {
+    size_t modes;                 /* M, the last one the lumped spring (b = 0) */
+    double eta;                   /* the lumped dashpot */
+    double a[CONTACT_MAX_MODES], b[CONTACT_MAX_MODES];
+    double phi[CONTACT_MAX_MODES]; /* the modes' state: the Maxwell springs' stretch [m] */
+    double h;                     /* the step length of the coefficients below (0: none yet) */
+    double sum_p, sum_q;          /* sum_i p_i, sum_i q_i */
+    double p[CONTACT_MAX_MODES], q[CONTACT_MAX_MODES];      /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
+    double keep[CONTACT_MAX_MODES], rate1[CONTACT_MAX_MODES], rate2[CONTACT_MAX_MODES]; /* the update */
+} contact_modes;
+
+/* The full G1 history (a springpot with memory = 1): x2 at every step since
+ * t = 0 and the G1 weights, grown geometrically. */
+typedef struct {
+    double *x2, *w;
+    size_t capacity;  /* of both */
+    size_t weights;   /* w[0..weights-1] hold the weights of order w_alpha */
+    double w_alpha;
+    double v_prev;    /* BDF2's second value back: v one step back (x_prev of the state holds x) */
+    double G_prev;    /* h^alpha times the G1 value of D^alpha x2 one step back */
+} contact_history;
+
 typedef struct {
     contact_params p;
-    double k;         /* the Hertz constant in use (given, or derived) */
+    double k;         /* the spring constant in use (given, or derived) */
+    double n_gamma;   /* Gamma(n + 1): x1^n = Gamma(n + 1) D^(-(n-1)) x1 */
     double inv_c;     /* 1/c */
     double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
     contact_state s;
+    contact_modes modes;      /* a springpot's compressed memory */
+    contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
 
 /* The paper's h20 test (MODEL.md §6, DESIGN.md): the parameters, and the
@@ -112,12 +170,44 @@ int contact_unused_material(const contact_params *p, char *msg, size_t len);
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len);
 
 /* Takes the parameters and the constants derived from them (k, 1/c, a fixed
- * stiffness), leaving the state alone: for a state restored from elsewhere. */
+ * stiffness, the compressed memory's kernel), leaving the state and the
+ * memory's values alone: for a state restored from elsewhere. */
 void contact_configure(contact_model *cm, const contact_params *p);
 
 /* Starts at t = 0 with the striker at the gap gap0 moving at v0 (towards the
- * specimen). Parameters and striker must have passed the checks above. */
+ * specimen). Parameters and striker must have passed the checks above. The
+ * model is overwritten: release one that holds a G1 history first. */
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m);
+
+/* Frees the G1 history's buffer (the only memory a model allocates, when a
+ * springpot with memory = 1 steps); the model may start again. A struct copy
+ * of such a model shares the buffer: never advance both. */
+void contact_release(contact_model *cm);
+
+/* The springpot's memory beside the state, as `count` values for saving and
+ * restoring it: the damper's rate x2' first, then the compressed modes'
+ * stretches (memory = 2), or BDF2's v one step back, the last G1 sum and
+ * x2 at every step since t = 0 (memory = 1, oldest first); none for the
+ * dashpot. To restore: the parameters and the state
+ * first (contact_configure), then contact_memory_accepts (the count fits
+ * them? 0, or -1 and a message), contact_memory_resize (room for the
+ * values; -1 when memory runs out, the model unchanged otherwise), and the
+ * values by contact_memory_set. */
+size_t contact_memory_count(const contact_model *cm);
+double contact_memory_get(const contact_model *cm, size_t i);
+int contact_memory_accepts(const contact_model *cm, size_t count, char *msg, size_t len);
+int contact_memory_resize(contact_model *cm, size_t count);
+void contact_memory_set(contact_model *cm, size_t i, double value);
+
+/* Whether an advance by H is possible from here: the full G1 history steps on
+ * the grid of dt_max (H a whole multiple of it, to 1e-9) and holds at most
+ * CONTACT_G1_HISTORY_MAX steps. 0, or -1 and a message. */
+int contact_check_advance(const contact_model *cm, double H, char *msg, size_t len);
+
+/* Whether the model steps on a uniform grid of dt_max whatever happens (the
+ * central scheme, the full G1 history): a caller advancing step by step
+ * should then advance by dt_max. */
+int contact_steps_uniformly(const contact_model *cm);
 
 /* Driven scene: the indentation rate v from now on; m > 0 lets the model move
  * the striker with that inertia until the next call (a proxy striker), m = 0
@@ -126,12 +216,19 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
 void contact_drive(contact_model *cm, double v, double m, double slope);
 
 /* The state's rates now: x1' (0 out of contact), v', and the spring force's
- * F' = 1.5 K sqrt(x1) x1' at the current stiffness. */
+ * F' = n K x1^(n-1) x1' at the current stiffness. */
 void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate);
+
+/* The damper's rate x2' now: F/c for the dashpot, the springpot's from its
+ * memory (negative while the dent recovers). */
+double contact_damper_rate(const contact_model *cm);
 
 /* Advances the model by H >= 0 in equal internal steps of at most dt_max that
  * land exactly on t + H, locating contact onset and separation within a step;
- * free flight is one exact step. Returns the impulse of the contact force
+ * free flight is one exact step (while a springpot recovers, steps growing
+ * with the time since separation). The full G1 history takes steps of
+ * dt_max, and onset and separation fall on them (contact_check_advance
+ * first). Returns the impulse of the contact force
  * over the interval [N s]; on a numerical failure (a non-finite state)
  * returns NaN and leaves the state as it was at the start of the advance. */
 double contact_advance(contact_model *cm, double H);
@@ -142,17 +239,18 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at);
 
 /* Whether the striker is out of contact and its free flight never reaches
  * the specimen again (it moves away, or rests, and nothing accelerates it
- * back): nothing changes from then on. */
+ * back; a recovering springpot's dent, x2 >= 0, only when the striker is
+ * clear of the undeformed surface): nothing it feels changes from then on. */
 int contact_never_returns(const contact_model *cm);
 
 /* Outputs derived from the state. */
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */
 double contact_total_indentation(const contact_model *cm);    /* x = x1 + x2 */
-double contact_semi_integral(const contact_model *cm);        /* the D^(-1/2) x1 used for F */
-double contact_semi_integral_per_force(const contact_model *cm); /* 1/(Gamma(5/2) k): F to it */
+double contact_semi_integral(const contact_model *cm);        /* the D^(-(n-1)) x1 used for F */
+double contact_semi_integral_per_force(const contact_model *cm); /* 1/(Gamma(n+1) k): F to it */
 
-/* The spring's stiffness K, its force being K x1^(3/2): k for the Hertz law,
- * k Gamma(N+3/2)/(Gamma(N) N^(3/2)) for the G1 law on N intervals (MODEL.md §4)
+/* The spring's stiffness K, its force being K x1^n: k for the Hertz law,
+ * k Gamma(N+n)/(Gamma(N) N^n) for the G1 law on N intervals (MODEL.md §4, §7)
  * with N = g1_nodes, or n_steps (internal steps since onset) when that is 0;
  * the extrapolated G1 law replaces that ratio by g1_line_ratio_extrapolated. */
 double contact_spring_stiffness(const contact_model *cm, long n_steps);
