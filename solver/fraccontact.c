@@ -122,6 +122,26 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
     return FC_OK;
 }
 
+size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, double *eta, char *msg, size_t len)
+{
+    contact_params q;
+    contact_model cm;
+    size_t i;
+    if (fc_params_check(p, msg, len) != FC_OK)
+        return 0;
+    fc_model_params(p, &q);
+    q.damper = CONTACT_DAMPER_SPRINGPOT;
+    q.memory = CONTACT_MEMORY_COMPRESSED;
+    contact_configure(&cm, &q);
+    if (cm.modes.modes <= max)
+        for (i = 0; i < cm.modes.modes; i++) {
+            a[i] = cm.modes.a[i];
+            b[i] = cm.modes.b[i];
+        }
+    *eta = cm.modes.eta;
+    return cm.modes.modes;
+}
+
 double fc_drop_velocity(double height)
 {
     return sqrt(2.0 * 9.81 * height);

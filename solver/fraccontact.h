@@ -175,6 +175,15 @@ FC_API void fc_result_free(fc_result *r);
  * out[i].status says which; fc_params_check tells why). */
 FC_API fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out);
 
+/* The compressed memory's kernel for the parameters' damper_order,
+ * memory_tolerance and dt_max (MODEL.md §8): tau^(-alpha)/Gamma(1-alpha) ~
+ * eta delta(tau) + sum_i a_i exp(-b_i tau), the last term the lumped spring
+ * (b = 0). Writes up to `max` terms and *eta; returns their number M (more
+ * than max: none written), or 0 with a message when the parameters fail
+ * their check. */
+FC_API size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, double *eta, char *msg,
+                               size_t len);
+
 /* sizeof(fc_params) and sizeof(fc_outcome): a binding checks its layout. */
 FC_API size_t fc_params_size(void);
 FC_API size_t fc_outcome_size(void);

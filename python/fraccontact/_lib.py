@@ -107,6 +107,10 @@ LIB.fc_run.argtypes = [ctypes.POINTER(Params), ctypes.c_double, ctypes.POINTER(R
                        ctypes.c_size_t]
 LIB.fc_result_free.argtypes = [ctypes.POINTER(Result)]
 LIB.fc_run_batch.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+LIB.fc_memory_kernel.restype = ctypes.c_size_t
+LIB.fc_memory_kernel.argtypes = [ctypes.POINTER(Params), ctypes.c_size_t, ctypes.POINTER(ctypes.c_double),
+                                 ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double), ctypes.c_char_p,
+                                 ctypes.c_size_t]
 
 
 def message_buffer():

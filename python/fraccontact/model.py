@@ -94,6 +94,21 @@ def warning(**params):
     return why.value.decode() if _lib.LIB.fc_params_warning(ctypes.byref(p), why, len(why)) else None
 
 
+def memory_kernel(**params):
+    """The compressed memory's kernel for these parameters (damper_order,
+    memory_tolerance, dt_max; MODEL.md §8): (a, b, eta) with
+    tau^(-alpha)/Gamma(1-alpha) ~ eta delta(tau) + sum a_i exp(-b_i tau),
+    the last term the lumped spring (b = 0)."""
+    p = _params(**params)
+    size = 256
+    a, b, eta = (ctypes.c_double * size)(), (ctypes.c_double * size)(), ctypes.c_double()
+    why = _lib.message_buffer()
+    n = _lib.LIB.fc_memory_kernel(ctypes.byref(p), size, a, b, ctypes.byref(eta), why, len(why))
+    if n == 0 and why.value:
+        raise ValueError(why.value.decode())
+    return np.array(a[:n]), np.array(b[:n]), eta.value
+
+
 @dataclass
 class Impact:
     """One finished impact."""
