@@ -12,7 +12,8 @@ OUTPUTS, STEP, GET_STATE, SET_STATE, FREE_STATE, SERIALIZE, DESERIALIZE, IN_DER,
 LOGGING, STRINGS, STATUSES, GET_INT_BOOL = 19, 20, 21, 22
 # indices into the harness's tables
 V = {0.0: 0, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
-REF = {1: 0, 2: 1, 9: 8, 10: 9, 11: 10, 12: 11, 13: 12, 30: 22, 31: 23, 32: 24, 40: 25}
+REF = {1: 0, 2: 1, 9: 8, 10: 9, 11: 10, 12: 11, 13: 12, 30: 22, 31: 23, 32: 24, 40: 25, 23: 29, 24: 30, 25: 31,
+       26: 32, 33: 33, 34: 34}
 
 
 def raw(x):
@@ -40,6 +41,11 @@ SEEDS = {
     "hostile_values": start(params=bytes([SET_REAL, REF[9]]) + raw(float("nan")) + bytes([SET_REAL, REF[10]])
                             + raw(5e-324) + bytes([SET_REAL, REF[1]]) + raw(1e300)) + steps(3, 1e3)
     + bytes([STEP, V[1e-5], 1]) + raw(0.5) + bytes([OUTPUTS]),
+    "springpot_compressed": start(params=bytes([SET_INT, REF[33], 2])) + steps(20)
+    + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5) + bytes([TERMINATE, FREE]),
+    "springpot_full_history": start(params=bytes([SET_INT, REF[33], 2, SET_INT, REF[34], 1, SET_REAL, REF[10], V[1e-5]]))
+    + steps(20) + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5)
+    + bytes([TERMINATE, FREE]),
     "out_of_order": bytes([STEP, V[1e-4], 0, EXIT, TERMINATE, INSTANTIATE, 0, STEP, V[1e-4], 0, OUTPUTS, EXIT,
                            GET_STATE, SERIALIZE, TERMINATE, ENTER, SET_INT, REF[30], 7, EXIT, EXIT, STEP, V[1e-4], 0,
                            ENTER, FREE_STATE, 0, FREE, FREE]),
