@@ -98,10 +98,12 @@ static void test_call_sequence(void)
  * naming it and the value, and keeps its previous value. */
 static void test_non_finite_reals(void)
 {
-    static const fmi2ValueReference vrs[] = {VR_v, VR_m, VR_R, VR_E_i, VR_nu_i, VR_E_s, VR_nu_s,
-                                             VR_k, VR_c, VR_dt_max, VR_g, VR_gap0};
-    static const char *const names[] = {"v", "m", "R", "E_i", "nu_i", "E_s", "nu_s",
-                                        "k", "c", "dt_max", "g", "gap0"};
+    static const fmi2ValueReference vrs[] = {VR_v, VR_m, VR_R, VR_E_i, VR_nu_i, VR_E_s, VR_nu_s, VR_k,
+                                             VR_c, VR_dt_max, VR_g, VR_gap0, VR_spring_exponent, VR_damper_order,
+                                             VR_c_alpha, VR_memory_tolerance};
+    static const char *const names[] = {"v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k",
+                                        "c", "dt_max", "g", "gap0", "spring_exponent", "damper_order",
+                                        "c_alpha", "memory_tolerance"};
     const double bad[] = {NAN, INFINITY, -INFINITY};
     const char *const shown[] = {"nan", "inf", "-inf"};
     fmi2Component c = instantiate("non-finite");
@@ -126,10 +128,14 @@ static void test_out_of_range(void)
         {VR_c, 0.0, "c"}, {VR_c, -1.0, "c"}, {VR_k, -1.0, "k"}, {VR_R, 0.0, "R"}, {VR_R, -1e-3, "R"},
         {VR_dt_max, 0.0, "dt_max"}, {VR_dt_max, -1e-7, "dt_max"}, {VR_m, -1.0, "m"},
         {VR_E_i, 0.0, "E_i"}, {VR_E_s, -2e9, "E_s"}, {VR_nu_i, 0.6, "nu_i"}, {VR_nu_s, -1.0, "nu_s"},
-        {VR_gap0, -1e-3, "gap0"}};
+        {VR_gap0, -1e-3, "gap0"}, {VR_spring_exponent, 0.5, "spring_exponent"},
+        {VR_spring_exponent, 11.0, "spring_exponent"}, {VR_damper_order, 0.0, "damper_order"},
+        {VR_damper_order, 1.5, "damper_order"}, {VR_c_alpha, 0.0, "c_alpha"}, {VR_c_alpha, -3e5, "c_alpha"},
+        {VR_memory_tolerance, 0.0, "memory_tolerance"}, {VR_memory_tolerance, 0.5, "memory_tolerance"}};
     struct { fmi2ValueReference vr; int value; const char *name; } ints[] = {
         {VR_law, 0, "law"}, {VR_law, 4, "law"}, {VR_scene, 0, "scene"}, {VR_scene, 3, "scene"},
-        {VR_g1_nodes, -1, "g1_nodes"}};
+        {VR_g1_nodes, -1, "g1_nodes"}, {VR_damper, 0, "damper"}, {VR_damper, 3, "damper"},
+        {VR_memory, 0, "memory"}, {VR_memory, 3, "memory"}};
     fmi2Component c = instantiate("range");
     fmi2ValueReference vr;
     size_t i;
