@@ -168,7 +168,8 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, central or reference; the Hertz constant used [N/m1.5]\n"
+           "  method, k    sdirk2, central, bdf2-g1 (a springpot's full G1 history) or reference; the\n"
+           "               spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
 }
@@ -423,7 +424,11 @@ static const char *stop_name(int stop)
 
 static const char *method_name(const options *o)
 {
-    return o->reference ? "reference" : o->p.scheme == 2 ? "central" : "sdirk2";
+    if (o->reference)
+        return "reference";
+    if (o->p.damper == 2 && o->p.memory == 1)
+        return "bdf2-g1"; /* the full G1 history's own scheme */
+    return o->p.scheme == 2 ? "central" : "sdirk2";
 }
 
 /* "name": value for each figure of an impact; null for a missing one. */
@@ -482,8 +487,13 @@ static void print_table(const options *o, const fc_result *r, double cpu_seconds
                                         "the striker moves away and nothing brings it back"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("%s, law %s, k = %.6g N/m^1.5, c = %.6g N s/m, m = %.6g kg, v = %.6g m/s\n", method_name(o),
-           laws[o->p.law], f->k, o->p.c, o->p.m, o->p.v);
+    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.law], f->k, o->p.spring_exponent);
+    if (o->p.damper == 2)
+        printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.damper_order, o->p.c_alpha,
+               o->p.damper_order, o->p.memory == 1 ? "full G1 history" : "compressed");
+    else
+        printf("c = %.6g N s/m, ", o->p.c);
+    printf("m = %.6g kg, v = %.6g m/s\n", o->p.m, o->p.v);
     if (r->n_impacts > 0) {
         printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");
         for (i = 0; i < r->n_impacts; i++) {
