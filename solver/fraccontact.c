@@ -151,7 +151,7 @@ int fc_params_warning(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;
     fc_model_params(p, &q);
-    return contact_unused_material(&q, msg, len);
+    return contact_unused_value(&q, msg, len);
 }
 
 /* t_c v / x_max of an elastic impact on the spring k x1^n (MODEL.md §2):

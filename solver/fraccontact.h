@@ -84,8 +84,8 @@ FC_API fc_status fc_params_check(const fc_params *p, char *msg, size_t len);
 /* sqrt(2 g h), g = 9.81 m/s^2: the impact velocity of a drop from height h [m]. */
 FC_API double fc_drop_velocity(double height);
 
-/* 1 and a message when a parameter has no effect (a material beside k != 0),
- * else 0. */
+/* 1 and a message when a parameter has no effect (a material beside k != 0,
+ * the other damper's parameters), else 0. */
 FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 
 /* What fc_parameter_at tells of each member of fc_params. */

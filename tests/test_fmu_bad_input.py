@@ -126,6 +126,37 @@ def assert_stepping_matches_the_default(s):
     assert s.get("eps") == pytest.approx(0.58606378, rel=1e-7, abs=0)  # the h20 default (README)
 
 
+# A damper's parameter set while the other damper is selected, and what
+# the warning must say (issue 12): the value has no effect, and why.
+UNUSED_DAMPER_VALUES = [
+    ({"damper_order": 0.3}, "damper_order = 0.3", "damper = 1"),
+    ({"c_alpha": 1e5}, "c_alpha = 100000", "damper = 1"),
+    ({"memory": 1}, "memory = 1", "damper = 1"),
+    ({"memory_tolerance": 1e-8}, "memory_tolerance = 1e-08", "damper = 1"),
+    ({"damper": 2, "c": 5000.0}, "c = 5000", "damper = 2"),
+    ({"damper": 2, "memory": 1, "memory_tolerance": 1e-8}, "memory_tolerance = 1e-08", "memory = 1"),
+]
+
+
+@pytest.mark.parametrize("values, named, because", UNUSED_DAMPER_VALUES)
+def test_a_damper_value_without_effect_warns(slave, values, named, because):
+    s = slave(start=False, **values)
+    s.enter()
+    assert s.fmu.exitInitializationMode() == 1  # fmi2Warning
+    warnings = [m for status, category, m in s.log if status == 1]
+    assert len(warnings) == 1 and named in warnings[0] and because in warnings[0], s.log
+    assert "no effect" in warnings[0]
+
+
+def test_no_warning_for_the_selected_dampers_own_values(slave):
+    for values in ({"c": 5000.0}, {"damper": 2, "damper_order": 0.3, "c_alpha": 1e5, "memory_tolerance": 1e-8},
+                   {"damper": 2, "memory": 1, "damper_order": 0.7}):
+        s = slave(start=False, **values)
+        s.enter()
+        assert s.fmu.exitInitializationMode() == 0, values
+        assert not [m for status, category, m in s.log if status == 1], s.log
+
+
 def test_no_warning_with_k_0_or_default_materials(slave):
     for values in ({}, {"k": 0.0, "E_s": 1.2e9}):
         s = slave(start=False, **values)

@@ -272,7 +272,7 @@ fm_status fm_start(fmu_model *fm, double t0)
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
     fm->started = 1;
-    if (contact_unused_material(&fm->params, why, sizeof why))
+    if (contact_unused_value(&fm->params, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     return FM_OK;
 }

@@ -177,7 +177,7 @@ static const struct {
 
 #define MATERIAL(p, i) (*(const double *)((const char *)(p) + materials[i].offset))
 
-int contact_unused_material(const contact_params *p, char *msg, size_t len)
+static int unused_material(const contact_params *p, char *msg, size_t len)
 {
     contact_params d;
     char text[32];
@@ -197,6 +197,43 @@ int contact_unused_material(const contact_params *p, char *msg, size_t len)
                  " %s no effect: k = %s is given and wins (set k = 0 to derive k from R, E_i, nu_i, E_s, nu_s)",
                  unused > 1 ? "have" : "has", shown(p->k, text));
     return 1;
+}
+
+/* A damper's parameter changed from its default while the other damper is
+ * selected, or the compressed memory's tolerance with the full history. */
+static int unused_damper_value(const contact_params *p, char *msg, size_t len)
+{
+    contact_params d;
+    char text[32];
+    const char *name = NULL, *why = NULL;
+    double value = 0.0;
+    contact_default_params(&d);
+    if (p->damper == CONTACT_DAMPER_DASHPOT) {
+        why = "damper = 1 (the dashpot, c) is selected; damper = 2 selects the springpot";
+        if (p->damper_order != d.damper_order)
+            name = "damper_order", value = p->damper_order;
+        else if (p->c_alpha != d.c_alpha)
+            name = "c_alpha", value = p->c_alpha;
+        else if (p->memory != d.memory)
+            name = "memory", value = p->memory;
+        else if (p->memory_tolerance != d.memory_tolerance)
+            name = "memory_tolerance", value = p->memory_tolerance;
+    } else if (p->c != d.c) {
+        name = "c", value = p->c;
+        why = "damper = 2 (the springpot, c_alpha and damper_order) is selected";
+    } else if (p->memory == CONTACT_MEMORY_G1 && p->memory_tolerance != d.memory_tolerance) {
+        name = "memory_tolerance", value = p->memory_tolerance;
+        why = "memory = 1 keeps the full G1 history, exact; the tolerance is memory = 2's";
+    }
+    if (!name)
+        return 0;
+    snprintf(msg, len, "%s = %s has no effect: %s", name, shown(value, text), why);
+    return 1;
+}
+
+int contact_unused_value(const contact_params *p, char *msg, size_t len)
+{
+    return unused_material(p, msg, len) || unused_damper_value(p, msg, len);
 }
 
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len)

@@ -159,10 +159,13 @@ int contact_check_params(const contact_params *p, char *msg, size_t len);
  * and returns -1: every check's message. */
 int contact_reject(char *msg, size_t len, const char *name, double value, const char *rule);
 
-/* A warning when k != 0 is given while a material parameter (R, E_i, nu_i,
- * E_s, nu_s) differs from its default: k wins, and that value has no effect.
- * Returns 1 and the message naming the first such parameter, or 0. */
-int contact_unused_material(const contact_params *p, char *msg, size_t len);
+/* A warning for a value without effect: k != 0 given while a material
+ * parameter (R, E_i, nu_i, E_s, nu_s) differs from its default (k wins), or
+ * a damper's parameter changed while the other damper is selected (c with
+ * the springpot; damper_order, c_alpha, memory, memory_tolerance with the
+ * dashpot; memory_tolerance with the full G1 history). Returns 1 and the
+ * message naming such parameters, or 0. */
+int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
 /* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
  * `scene` with the parameters *p (which must have passed their check): a
