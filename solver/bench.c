@@ -8,10 +8,19 @@
  *   fraccontact-bench batch N LAW DT_MAX
  *                                     the library's own CPU for N h20 impacts in
  *                                     one fc_run_batch call (the C core's cost of
- *                                     what fraccontact.impacts does from Python) */
+ *                                     what fraccontact.impacts does from Python)
+ *   fraccontact-bench springpot [LARGEST_N]
+ *                                     ns per internal step over the h20 impact of
+ *                                     the dashpot, the springpot's compressed
+ *                                     memory and its full G1 history; then a
+ *                                     springpot impact by both memories on N =
+ *                                     1e3, 1e4, ... LARGEST_N (default 1e6)
+ *                                     steps of one span: CPU, F_peak, eps, the
+ *                                     memory's values and the history's heap */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -165,6 +174,147 @@ static int bench_batch(size_t N, int law, double dt_max)
     return 0;
 }
 
+/* ------------------------------------------------------------ springpot */
+
+/* The springpot of the issue-12 benchmarks: alpha 0.5, c_alpha 3e5 (the
+ * defaults: as damping as the h20 dashpot at the impact's frequency). */
+static void springpot_params(contact_params *p, int memory, double dt_max)
+{
+    contact_default_params(p);
+    p->damper = CONTACT_DAMPER_SPRINGPOT;
+    p->damper_order = 0.5;
+    p->c_alpha = 3e5;
+    p->memory = memory;
+    p->dt_max = dt_max;
+}
+
+typedef struct {
+    double seconds;        /* CPU of the run */
+    int64_t steps;         /* internal steps taken */
+    int64_t impacts;
+    double F_peak, eps, t;
+    size_t memory_values;  /* contact_memory_count at the end: the FMU state's share */
+    size_t history_bytes;  /* the full history's heap (x2 and weights) */
+    size_t modes;          /* the compressed memory's M */
+} impact_run;
+
+/* One h20 impact from t = 0 in calls of 100 internal steps of dt_max, as an
+ * FMU takes them: until the first impact ends (span 0), or over exactly
+ * `span` (a whole number of calls). 0, or -1 when a call fails. */
+static int run_impact(const contact_params *p, double span, impact_run *out)
+{
+    contact_model cm;
+    double v0, m, H = 100.0 * p->dt_max, t0;
+    long calls = span > 0.0 ? lround(span / H) : 0, i;
+    char why[512];
+    int failed = 0;
+    contact_default_striker(&v0, &m);
+    contact_start(&cm, p, v0, m);
+    if (contact_check_advance(&cm, span > 0.0 ? calls * H : H, why, sizeof why) != 0) {
+        fprintf(stderr, "fraccontact-bench: %s\n", why);
+        return -1;
+    }
+    t0 = cpu_seconds();
+    if (span > 0.0) {
+        for (i = 0; i < calls && !failed; i++)
+            failed = isnan(contact_advance(&cm, H));
+    } else {
+        while (cm.s.impacts == 0 && !failed)
+            failed = isnan(contact_advance(&cm, H));
+    }
+    out->seconds = cpu_seconds() - t0;
+    out->steps = cm.s.steps;
+    out->impacts = cm.s.impacts;
+    out->F_peak = cm.s.F_peak;
+    out->eps = cm.s.eps;
+    out->t = cm.s.t;
+    out->memory_values = contact_memory_count(&cm);
+    out->history_bytes = cm.history.capacity * 2 * sizeof(double);
+    out->modes = cm.modes.modes;
+    contact_release(&cm);
+    if (failed)
+        fprintf(stderr, "fraccontact-bench: the model failed at t = %g s\n", cm.s.t);
+    return failed ? -1 : 0;
+}
+
+/* The median over repeats of ns per step and of the run's seconds: as many
+ * repeats as fit in about `budget` seconds (at least 3, at most `most`), a
+ * single run when the first takes over a minute. *repeats says how many. */
+static int timed_impacts(const contact_params *p, double span, double budget, int most, impact_run *out,
+                         double *ns, int *repeats)
+{
+    double per_step[15], seconds[15];
+    int r, n;
+    if (run_impact(p, span, out) != 0)
+        return -1;
+    n = out->seconds > 60.0 ? 1 : (int)fmin((double)most, fmax(3.0, ceil(budget / fmax(out->seconds, 1e-9))));
+    for (r = 0; r < n; r++) {
+        if (r > 0 && run_impact(p, span, out) != 0)
+            return -1;
+        per_step[r] = out->seconds / (double)out->steps * 1e9;
+        seconds[r] = out->seconds;
+    }
+    *ns = median(per_step, n);
+    out->seconds = median(seconds, n);
+    *repeats = n;
+    return 0;
+}
+
+static void print_run(const char *name, const impact_run *r, double ns, int repeats)
+{
+    printf("\"%s\": {\"ns_per_step\": %.2f, \"seconds\": %.6g, \"repeats\": %d, \"steps\": %lld, \"impacts\": %lld, "
+           "\"F_peak\": %.17g, \"eps\": %.17g, \"t\": %.17g, \"memory_values\": %lu, \"history_bytes\": %lu, "
+           "\"modes\": %lu}",
+           name, ns, r->seconds, repeats, (long long)r->steps, (long long)r->impacts, r->F_peak, r->eps, r->t,
+           (unsigned long)r->memory_values, (unsigned long)r->history_bytes, (unsigned long)r->modes);
+}
+
+/* The span of the ladder: the springpot's h20 impact lasts 1.42 ms. */
+#define SPRINGPOT_SPAN 1.5e-3
+
+static int bench_springpot(double largest)
+{
+    contact_params p;
+    impact_run r;
+    double ns, N;
+    int repeats, first = 1;
+    printf("{\"sizeof_contact_model\": %lu, \"h20\": {\"dt_max\": %g, ", (unsigned long)sizeof(contact_model), 1e-7);
+    contact_default_params(&p);
+    if (timed_impacts(&p, 0.0, 0.3, 15, &r, &ns, &repeats) != 0)
+        return 1;
+    print_run("dashpot", &r, ns, repeats);
+    springpot_params(&p, CONTACT_MEMORY_COMPRESSED, 1e-7);
+    if (timed_impacts(&p, 0.0, 0.3, 15, &r, &ns, &repeats) != 0)
+        return 1;
+    printf(", ");
+    print_run("compressed", &r, ns, repeats);
+    springpot_params(&p, CONTACT_MEMORY_G1, 1e-7);
+    if (timed_impacts(&p, 0.0, 1.0, 9, &r, &ns, &repeats) != 0)
+        return 1;
+    printf(", ");
+    print_run("full", &r, ns, repeats);
+    printf("}, \"span\": %g, \"ladder\": [", SPRINGPOT_SPAN);
+    fflush(stdout);
+    for (N = 1e3; N <= largest * (1.0 + 1e-9); N *= 10.0) {
+        double dt = SPRINGPOT_SPAN / N;
+        printf("%s{\"N\": %.0f, \"dt_max\": %.17g, ", first ? "" : ", ", N, dt);
+        first = 0;
+        springpot_params(&p, CONTACT_MEMORY_COMPRESSED, dt);
+        if (timed_impacts(&p, SPRINGPOT_SPAN, 2.0, 15, &r, &ns, &repeats) != 0)
+            return 1;
+        print_run("compressed", &r, ns, repeats);
+        printf(", ");
+        springpot_params(&p, CONTACT_MEMORY_G1, dt);
+        if (timed_impacts(&p, SPRINGPOT_SPAN, 2.0, 9, &r, &ns, &repeats) != 0)
+            return 1;
+        print_run("full", &r, ns, repeats);
+        printf("}");
+        fflush(stdout);
+    }
+    printf("]}\n");
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 5 && strcmp(argv[1], "batch") == 0 && atol(argv[2]) > 0)
@@ -173,6 +323,8 @@ int main(int argc, char **argv)
         return bench_step();
     if (argc == 4 && strcmp(argv[1], "g1") == 0 && atol(argv[2]) > 0)
         return bench_g1((size_t)atol(argv[2]), atof(argv[3]));
-    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX\n");
+    if ((argc == 2 || (argc == 3 && atof(argv[2]) >= 1e3)) && strcmp(argv[1], "springpot") == 0)
+        return bench_springpot(argc == 3 ? atof(argv[2]) : 1e6);
+    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX | springpot [LARGEST_N]\n");
     return 2;
 }

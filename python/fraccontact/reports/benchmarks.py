@@ -8,21 +8,33 @@
      every grid point against the closed form of MODEL.md §4;
   4. the Python package against the C core: fraccontact.impacts against
      fraccontact-bench batch (CPU per impact), a process per impact,
-     fraccontact sweep on 1 and 2 local Dask workers, a 1000-row curve fit.
+     fraccontact sweep on 1 and 2 local Dask workers, a 1000-row curve fit;
+  5. the springpot (issue 12): ns per internal step of the dashpot, the
+     compressed memory and the full G1 history over the h20 impact; a
+     springpot impact by both memories on N = 1e3 .. 1e6 steps of one span
+     (the full history's N = 1e6 run, O(N^2), timed once: about 10 minutes),
+     their F_peak and eps agreement; the FMU state sizes; and the dashpot on
+     this build against the commit before the springpot (BASE, built in a
+     temporary git worktree), side by side.
 Writes docs/benchmarks.md. Medians of repeated runs; CPU time of one process
-for 1 to 3 and the per-impact costs of 4, wall time for 4's sweeps and fit.
+for 1 to 3, 5 and the per-impact costs of 4, wall time for 4's sweeps and fit.
 
-Regenerate: scripts/report benchmarks   (several minutes)
-            scripts/report benchmarks --only package   (section 4 alone, in place)
+Regenerate: scripts/report benchmarks   (about 20 minutes)
+            scripts/report benchmarks --only package     (section 4 alone, in place)
+            scripts/report benchmarks --only springpot   (section 5 alone, in place)
 """
 
+import contextlib
 import json
 import math
 import os
+import pathlib
 import platform
+import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 import numpy as np
@@ -30,7 +42,7 @@ from scipy.special import gamma
 
 import differint.differint as differint
 
-from .. import atomic, fit, model, reports, solver
+from .. import atomic, fit, fmu, model, reports, solver
 from ..scipy_contact import solve_drop
 
 H20 = model.defaults()
@@ -46,6 +58,13 @@ PROCESSES = 300  # impacts run as one fraccontact-solve process each
 REPEATS = 3
 FIT_ROWS = 1000
 BEGIN, END = "<!-- package: begin -->", "<!-- package: end -->"
+SPRINGPOT_BEGIN, SPRINGPOT_END = "<!-- springpot: begin -->", "<!-- springpot: end -->"
+# Section 5: the commit before the springpot, whose dashpot this build's must
+# match; rounds alternating its fraccontact-bench and this build's.
+BASE = "65bf8cb"
+BASE_ROUNDS = 7
+REGENERATE = ("Regenerate: `scripts/report benchmarks` (about 20 minutes; the springpot's section alone: "
+              "`scripts/report benchmarks --only springpot`, about 15)")
 
 
 def say(text):
@@ -311,27 +330,335 @@ def package_section(rows, fitted):
     return out
 
 
-def replace_section(path, section):
-    """The report at path with the section between BEGIN and END replaced
-    (appended when it has none)."""
+def replace_section(path, section, begin=BEGIN, end=END):
+    """The report at path with the section between begin and end replaced
+    (appended when it has none), and its regeneration line brought up to
+    date."""
     text = path.read_text() if path.exists() else "# Benchmarks\n"
     block = "\n".join(section) + "\n"
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + block.rstrip("\n") + rest.split(END, 1)[1]
+    if begin in text and end in text:
+        head, rest = text.split(begin, 1)
+        text = head + block.rstrip("\n") + rest.split(end, 1)[1]
     else:
         text = text.rstrip("\n") + "\n\n" + block
-    atomic.write_text(path, text)
+    lines = text.split("\n")
+    for i, line in enumerate(lines):
+        if line.startswith("Regenerate: `scripts/report benchmarks`"):
+            lines[i] = REGENERATE + line[line.index(")") + 1:] if ")" in line else REGENERATE
+            break
+    atomic.write_text(path, "\n".join(lines))
+
+
+# --- 5. the springpot --------------------------------------------------------
+
+class LoadWatch:
+    """The 1-minute load average while a block runs, sampled every 10 s."""
+
+    def __init__(self):
+        self.samples = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._sample, daemon=True)
+
+    def _sample(self):
+        while not self._stop.wait(10.0):
+            self.samples.append(os.getloadavg()[0])
+
+    def __enter__(self):
+        self.samples.append(os.getloadavg()[0])
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+        self.samples.append(os.getloadavg()[0])
+
+
+def git(root, *args):
+    done = subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"git {' '.join(args)} failed: {done.stderr.strip()}")
+    return done.stdout.strip()
+
+
+@contextlib.contextmanager
+def base_build(root, commit):
+    """fraccontact-bench and the FMU of `commit`, built (Release) in a
+    temporary git worktree, which is removed afterwards."""
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="fraccontact-base-"))
+    tree, build = folder / "tree", folder / "build"
+    git(root, "worktree", "add", "--detach", str(tree), commit)
+    try:
+        for command in (["cmake", "-S", tree, "-B", build, "-DCMAKE_BUILD_TYPE=Release",
+                         f"-DPython3_EXECUTABLE={sys.executable}"],
+                        ["cmake", "--build", build, "-j2", "--target", "fraccontact-bench", "fraccontact_fmu"]):
+            done = subprocess.run([str(c) for c in command], capture_output=True, text=True)
+            if done.returncode != 0:
+                raise SystemExit(f"{' '.join(map(str, command))} failed:\n{done.stdout[-3000:]}{done.stderr[-3000:]}")
+        yield dict(tree=tree, bench=build / "fraccontact-bench", fmu=build / "fraccontact.fmu",
+                   commit=git(root, "rev-parse", "--short", commit))
+    finally:
+        subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tree)], capture_output=True)
+        subprocess.run(["git", "-C", str(root), "worktree", "prune"], capture_output=True)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def model_sizes(tree):
+    """sizeof(contact_model) and sizeof(contact_state) of the model's header
+    in tree (what an FMU instance or a library run holds in memory), or None
+    without a C compiler."""
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if not cc:
+        return None
+    with tempfile.TemporaryDirectory() as folder:
+        exe = os.path.join(folder, "sizes")
+        source = ('#include <stdio.h>\n#include "contact.h"\nint main(void) { printf("%zu %zu\\n", '
+                  'sizeof(contact_model), sizeof(contact_state)); return 0; }\n')
+        done = subprocess.run([cc, "-I", str(pathlib.Path(tree) / "fmu_src" / "model"), "-x", "c", "-", "-o", exe],
+                              input=source, capture_output=True, text=True)
+        if done.returncode != 0:
+            return None
+        model_bytes, state_bytes = map(int, subprocess.run([exe], capture_output=True, text=True).stdout.split())
+    return dict(model=model_bytes, state=state_bytes)
+
+
+def dashpot_side_by_side(base_bench, bench):
+    """The dashpot on both builds, BASE_ROUNDS rounds alternating them (the
+    order swapped every round): fraccontact-bench step's ns per internal
+    step (law 1 and law 2), and fc_run_batch's CPU per impact at the package
+    section's two settings, with the first impact's F_peak of each."""
+    keys = ("g1", "hertz", "batch_cheap", "batch_default")
+    got = {side: {k: [] for k in keys} | {"F_peak": set()} for side in ("base", "this")}
+    for r in range(BASE_ROUNDS):
+        say(f"  the dashpot, round {r + 1} of {BASE_ROUNDS} ...")
+        order = (("base", base_bench), ("this", bench))
+        for side, program in (order if r % 2 == 0 else order[::-1]):
+            steps = run(program, "step")["ns_per_step"]
+            got[side]["g1"].append(steps["g1"])
+            got[side]["hertz"].append(steps["hertz"])
+            for key, (n, law, dt) in (("batch_cheap", (2000, 2, 3e-6)), ("batch_default", (300, 1, 1e-7))):
+                b = run(program, "batch", n, law, dt)
+                got[side][key].append(b["seconds_per_impact"])
+                got[side]["F_peak"].add((key, b["F_peak_first"]))
+    return got
+
+
+def state_bytes(s):
+    """The size of a serialized FMU state of the slave now."""
+    state = s.fmu.getFMUstate()
+    size = len(s.fmu.serializeFMUstate(state))
+    s.fmu.freeFMUstate(state)
+    return size
+
+
+def fmu_state_sizes(path, **values):
+    """The serialized state's bytes of the h20 drop through the FMU in 10 us
+    communication steps: at the start, after 1e4 internal steps (t = 1 ms, in
+    contact from t = 0 at dt_max 1e-7) and at 1.5 ms, after the impact."""
+    md, folder = fmu.unpacked(str(path))
+    s = fmu.Slave(md, folder, **values)
+    sizes = {"start": state_bytes(s)}
+    for i in range(1, 151):
+        s.step(1e-5)
+        if i == 100:
+            sizes["1e4"] = state_bytes(s)
+    sizes["after"] = state_bytes(s)
+    sizes["eps"], sizes["F_peak"] = s.get("eps"), s.get("F_peak")
+    s.free()
+    return sizes
+
+
+def resting_state_sizes(path):
+    """The compressed memory's state over a long run: the striker resting on
+    the specimen under gravity (v = 0, g = 9.81), in contact throughout, 1 s
+    in 1 ms communication steps; the library counts the internal steps."""
+    md, folder = fmu.unpacked(str(path))
+    s = fmu.Slave(md, folder, damper=2, memory=2, v=0.0, g=9.81)
+    start = state_bytes(s)
+    for _ in range(1000):
+        s.step(1e-3)
+    end, contact = state_bytes(s), s.get("contact")
+    s.free()
+    run_ = model.impacts(damper=2, memory=2, v=0.0, g=9.81, t_end=1.0)
+    return dict(start=start, end=end, contact=contact, steps=int(run_["steps"]), stopped=str(run_["stopped"]))
+
+
+def springpot_rows(root, bench, fmu_file, largest):
+    started = time.perf_counter()
+    head = git(root, "rev-parse", "--short", "HEAD")
+    dirty = bool(git(root, "status", "--porcelain", "--", "fmu_src", "solver", "CMakeLists.txt"))
+    with LoadWatch() as load:
+        say(f"  building {BASE} in a temporary git worktree ...")
+        with base_build(root, BASE) as base:
+            base_sizes = model_sizes(base["tree"])
+            side = dashpot_side_by_side(base["bench"], bench)
+            say("  FMU states ...")
+            states = {"base dashpot": fmu_state_sizes(base["fmu"])}
+        states["dashpot"] = fmu_state_sizes(fmu_file)
+        states["compressed"] = fmu_state_sizes(fmu_file, damper=2, memory=2)
+        states["full"] = fmu_state_sizes(fmu_file, damper=2, memory=1)
+        resting = resting_state_sizes(fmu_file)
+        say(f"  fraccontact-bench springpot {largest:g} (the full history's largest N is O(N^2): minutes) ...")
+        sp = run(bench, "springpot", f"{largest:g}")
+    return dict(head=head, dirty=dirty, base=base["commit"], load=load.samples, side=side, states=states,
+                resting=resting, sizes=dict(base=base_sizes, this=model_sizes(root)), sp=sp,
+                minutes=(time.perf_counter() - started) / 60)
+
+
+def springpot_section(r):
+    sp, h20, st, side = r["sp"], r["sp"]["h20"], r["states"], r["side"]
+    dash, comp, full = h20["dashpot"], h20["compressed"], h20["full"]
+    bar = comp["ns_per_step"] / dash["ns_per_step"]
+    load = r["load"]
+
+    def med(side_, key):
+        return float(np.median(side[side_][key]))
+
+    def spread(side_, key):
+        v = side[side_][key]
+        return (max(v) - min(v)) / float(np.median(v))
+
+    def rel(a, b):
+        return abs(a / b - 1.0)
+
+    out = [SPRINGPOT_BEGIN, "## The springpot: compressed memory against the full G1 history", "",
+           "Regenerate this section alone, in place: `scripts/report benchmarks --only springpot` (this run: "
+           f"{r['minutes']:.1f} minutes, most of it the full history's N = {sp['ladder'][-1]['N']:,.0f} run). "
+           f"Measured side by side in one run on commit {r['head']}"
+           + (" (with uncommitted changes to fmu_src/, solver/ or CMakeLists.txt in the working tree)"
+              if r["dirty"] else "")
+           + f", on {platform.processor() or platform.machine()} ({platform.system()}, {os.cpu_count()} cores "
+           f"shared with other work: 1-minute load average {min(load):.2f} to {max(load):.2f} during the run, "
+           f"sampled every 10 s), CPU time of one process. The springpot: alpha = 0.5, c_alpha = 3e5 N·s^alpha/m "
+           "(the defaults: as damping as the h20 dashpot at the impact's frequency), `memory_tolerance` 1e-6; the "
+           "h20 drop (v = 0.626 m/s, m = 0.7437 kg, k = 3.299e8 N/m^1.5, G1 spring law), advanced 100 internal "
+           "steps per `contact_advance` call as an FMU with a 10 us communication step takes them "
+           "(`fraccontact-bench springpot`).", "",
+           "### Cost of an internal step", "",
+           f"The h20 impact at `dt_max` = {h20['dt_max']:g} s, until it ends, median of the repeats. The full "
+           "history's step sums over every step since t = 0, so its cost grows with the run: its figure is the mean "
+           "over this impact. Memory values: what the FMU state carries beside the fixed fields "
+           "(`contact_memory_count`, 8 bytes each).", "",
+           "| damper | internal steps | ns per internal step | / dashpot | repeats | memory values | "
+           "FMU state at 1e4 steps | after the impact |", "|---|---|---|---|---|---|---|---|"]
+    for label, x, s in (("dashpot (`damper` 1)", dash, st["dashpot"]),
+                        (f"springpot, compressed memory (`memory` 2, M = {comp['modes']} modes)", comp,
+                         st["compressed"]),
+                        ("springpot, full G1 history (`memory` 1)", full, st["full"])):
+        out.append(f"| {label} | {x['steps']:,} | {x['ns_per_step']:,.1f} | "
+                   f"{x['ns_per_step'] / dash['ns_per_step']:,.2f}x | {x['repeats']} | {x['memory_values']:,} | "
+                   f"{s['1e4']:,} B | {s['after']:,} B |")
+    paragraph = (f"The issue's bar, a compressed step at most 5x the dashpot's: "
+                 f"{'**met**' if bar <= 5 else '**not met**'} ({bar:.2f}x). "
+                 f"The compressed memory's FMU state keeps its size: {st['compressed']['start']:,} B at t = 0, "
+                 f"{st['compressed']['1e4']:,} B after 1e4 steps, {r['resting']['end']:,} B after "
+                 f"{r['resting']['steps']:,} internal steps (a striker resting on the specimen under gravity for 1 s, "
+                 f"in contact at the end: {'yes' if r['resting']['contact'] else 'no'}). The full history's grows "
+                 "by 8 bytes a step (x2 at every step since t = 0) and is refused past 1,048,576 steps (about "
+                 f"8 MiB); in memory it also holds the G1 weights, {full['history_bytes']:,} B of heap after this "
+                 "impact.")
+    if r["sizes"]["this"]:
+        paragraph += (" Each model (an FMU instance, a library run) is a `contact_model` of "
+                      f"{r['sizes']['this']['model']:,} B whatever the damper")
+        if r["sizes"]["base"]:
+            paragraph += (f" ({r['sizes']['base']['model']:,} B before the springpot: the compressed memory's "
+                          "160 modes' arrays are inside it)")
+        paragraph += "."
+    out += ["", paragraph, ""]
+    out += ["### The N ladder: compressed memory against the full history", "",
+            f"A springpot impact over a fixed span of {sp['span'] * 1e3:g} ms (the impact lasts 1.42 ms, then the "
+            "dent recovers), `dt_max` = span / N, both memories in the same run. The full history takes exactly "
+            "N steps; the compressed memory takes N steps' worth in contact and a few growing ones once the "
+            "striker has left. CPU of the whole span, median of the repeats shown (as many as fit in about 2 s, "
+            "at least 3; a run over a minute is timed once).", "",
+            "| N | dt_max [s] | compressed: M, steps | compressed: CPU (ns per step) | repeats | "
+            "full history: CPU (ns per step) | repeats | speed-up | speed-up over the previous N |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    previous = None
+    for row in sp["ladder"]:
+        c, f = row["compressed"], row["full"]
+        speedup = f["seconds"] / c["seconds"]
+        growth = f"{speedup / previous:.1f}x" if previous else ""
+        previous = speedup
+        out.append(f"| {row['N']:,.0f} | {row['dt_max']:.3g} | {c['modes']}, {c['steps']:,} | "
+                   f"{seconds(c['seconds'])} ({c['ns_per_step']:,.0f}) | {c['repeats']} | "
+                   f"{seconds(f['seconds'])} ({f['ns_per_step']:,.0f}) | {f['repeats']}"
+                   f"{' (once)' if f['repeats'] == 1 else ''} | {speedup:,.0f}x | {growth} |")
+    finest = sp["ladder"][-1]["full"]
+    ladder = sp["ladder"]
+    ups = [row["full"]["seconds"] / row["compressed"]["seconds"] for row in ladder]
+    per_decade = (ups[-1] / ups[0]) ** (1.0 / math.log10(ladder[-1]["N"] / ladder[0]["N"])) if len(ups) > 1 else 0
+    ns_c = [row["compressed"]["ns_per_step"] for row in ladder]
+    modes = [row["compressed"]["modes"] for row in ladder]
+    out += ["", f"The compressed memory's cost per step stays between {min(ns_c):.0f} and {max(ns_c):.0f} ns (M "
+            f"from {min(modes)} to {max(modes)} modes: its kernel spans `dt_max` to 1e3 s, so M grows slowly as "
+            "`dt_max` falls); the full history's grows like N, its work like N^2. The speed-up grows by "
+            f"{per_decade:.1f}x per decade of N on average (10x would be exactly like N).", "",
+            "At the same accuracy: the first impact's F_peak and eps by both memories at each N, their relative "
+            f"difference, and each against the full history at the largest N ({finest['steps']:,} steps) as the "
+            "reference.", "",
+            "| N | F_peak compressed [N] | F_peak full [N] | difference | eps compressed | eps full | difference | "
+            "F_peak against the reference: compressed, full | eps against the reference: compressed, full |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for row in sp["ladder"]:
+        c, f = row["compressed"], row["full"]
+        out.append(f"| {row['N']:,.0f} | {c['F_peak']:.9g} | {f['F_peak']:.9g} | {rel(c['F_peak'], f['F_peak']):.1e} | "
+                   f"{c['eps']:.9f} | {f['eps']:.9f} | {rel(c['eps'], f['eps']):.1e} | "
+                   f"{rel(c['F_peak'], finest['F_peak']):.1e}, {rel(f['F_peak'], finest['F_peak']):.1e} | "
+                   f"{rel(c['eps'], finest['eps']):.1e}, {rel(f['eps'], finest['eps']):.1e} |")
+    out += ["", "Both memories converge to the same impact; at a given N their difference is that of two second-order "
+            "time schemes (SDIRK2 on the modes, BDF2 with the G1 sum shifted to the step's end) plus the kernel's "
+            "tolerance, not the memory's compression alone.", "",
+            f"### The dashpot pays nothing? This build against {r['base']}, the commit before the springpot", "",
+            f"{r['base']} built in a temporary git worktree (Release, removed afterwards), its `fraccontact-bench` "
+            f"and this build's alternated for {BASE_ROUNDS} rounds, the order swapped every round; medians, and the "
+            "spread of the rounds (largest minus smallest over the median). `step`: ns per internal step over the "
+            "h20 impact, 100 steps per call; `batch`: the library's CPU per impact of one `fc_run_batch` call "
+            "(median of 5 inside). FMU state: serialized through fmpy after the h20 impact by each build's FMU.",
+            "", f"| measure | {r['base']} | this commit | this / {r['base']} |", "|---|---|---|---|"]
+    rows = (("ns per internal step, law 1 (G1), `fraccontact-bench step`", "g1", 1.0, "{:.1f}"),
+            ("ns per internal step, law 2 (Hertz), `fraccontact-bench step`", "hertz", 1.0, "{:.1f}"),
+            ("us per impact, 2,000 impacts, law 2, dt_max 3e-6, `fraccontact-bench batch`", "batch_cheap", 1e6,
+             "{:.2f}"),
+            ("us per impact, 300 impacts, law 1, dt_max 1e-7, `fraccontact-bench batch`", "batch_default", 1e6,
+             "{:.1f}"))
+    ratios, noise = [], []
+    for label, key, scale, fmt in rows:
+        b, t = med("base", key), med("this", key)
+        ratios.append(t / b)
+        noise.append(max(spread("base", key), spread("this", key)))
+        out.append(f"| {label} | {fmt.format(b * scale)} (spread {100 * spread('base', key):.0f} %) | "
+                   f"{fmt.format(t * scale)} (spread {100 * spread('this', key):.0f} %) | {t / b:.3f} |")
+    sb, sa = st["base dashpot"]["after"], st["dashpot"]["after"]
+    out.append(f"| FMU state after the h20 impact | {sb:,} B | {sa:,} B | {sa / sb:.3f} |")
+    if r["sizes"]["this"] and r["sizes"]["base"]:
+        out.append(f"| `sizeof(contact_model)`: an instance's model in memory | {r['sizes']['base']['model']:,} B | "
+                   f"{r['sizes']['this']['model']:,} B | {r['sizes']['this']['model'] / r['sizes']['base']['model']:.1f} |")
+    same = side["base"]["F_peak"] == side["this"]["F_peak"]
+    within = all(abs(q - 1.0) <= max(n, 0.03) for q, n in zip(ratios, noise))
+    out += ["", f"Per step and per impact the dashpot's cost is {'within' if within else '**outside**'} the noise of "
+            f"this machine (ratios {min(ratios):.3f} to {max(ratios):.3f}; the rounds of one binary spread by up to "
+            f"{100 * max(noise):.0f} %), and its results are {'bit-identical' if same else '**not identical**'} "
+            f"(the first impact's F_peak of both batch settings). Its FMU state "
+            + ("is the same size." if sa == sb else
+               f"is {sa - sb:+d} bytes ({sb} to {sa}: the new parameters `spring_exponent` and `damper` are saved in "
+               "every state; a dashpot's carries no memory values)."),
+            SPRINGPOT_END]
+    return out
+
+
+def seconds(x):
+    return f"{x * 1e3:.3g} ms" if x < 1 else f"{x:,.1f} s"
 
 
 # --- the report ---------------------------------------------------------------
 
-def write(path, steps, impacts, g1, alpha, package):
+def write(path, steps, impacts, g1, alpha, package, springpot):
     h = steps["ns_per_step"]
     lit = steps["ns_literal_sum"]
     ours = impacts[0]["cpu"]
     out = ["# Benchmarks", "",
-           "Regenerate: `scripts/report benchmarks` (a few minutes). Everything below was measured side by side "
+           f"{REGENERATE}. Everything below was measured side by side "
            f"in one run, on {platform.processor() or platform.machine()} ({platform.system()}), one process, "
            "CPU time, medians of repeated runs. On this shared virtual machine the same binary's timings move by "
            "up to 30 % from one run to the next; the ratios within one run are steadier.", "",
@@ -381,15 +708,19 @@ def write(path, steps, impacts, g1, alpha, package):
             f"wrong; for an odd number of points it also returns one value too few ({lengths} points; a missing "
             "point counts as off). `GLpoint` scales by (N+1)/(b-a) where the grid's step is (b-a)/N, an O(1/N) "
             "error. Ours is compiled and O(N) at the newest point; over the full grid it pays for the padding and "
-            "the direct head but is right at every point.", ""] + package
+            "the direct head but is right at every point.", ""] + package + [""] + springpot
     atomic.write_text(path, "\n".join(out) + "\n")
 
 
 def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
-    parser.add_argument("--only", choices=["package"],
-                        help="regenerate one section alone, in place (package: the Python package against the C core)")
+    reports.add_fmu(parser)
+    parser.add_argument("--only", choices=["package", "springpot"],
+                        help="regenerate one section alone, in place (package: the Python package against the C core; "
+                             "springpot: the springpot's memories, and the dashpot against the commit before them)")
+    parser.add_argument("--largest-n", type=float, default=1e6,
+                        help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = reports.parse(parser, argv)
     program, bench = args.solver, solver.bench_path(args.solver)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -398,14 +729,23 @@ def main(argv=None, prog=None):
         replace_section(args.out / "benchmarks.md", package_section(*package_rows(program, bench)))
         print((args.out / "benchmarks.md").read_text())
         return
-    say("1/4 cost of a step ...")
+    if args.only == "springpot":
+        say("the springpot ...")
+        section = springpot_section(springpot_rows(reports.source_tree(), bench, args.fmu, args.largest_n))
+        replace_section(args.out / "benchmarks.md", section, SPRINGPOT_BEGIN, SPRINGPOT_END)
+        print((args.out / "benchmarks.md").read_text())
+        return
+    root = reports.source_tree()
+    say("1/5 cost of a step ...")
     steps = step_costs(bench)
-    say("2/4 impacts per second ...")
+    say("2/5 impacts per second ...")
     impacts = impacts_per_second(program)
-    say("3/4 G1 against differint ...")
+    say("3/5 G1 against differint ...")
     g1 = g1_rows(bench, -0.5)
-    say("4/4 the Python package against the C core ...")
+    say("4/5 the Python package against the C core ...")
     package = package_section(*package_rows(program, bench))
-    write(args.out / "benchmarks.md", steps, impacts, g1, -0.5, package)
+    say("5/5 the springpot ...")
+    springpot = springpot_section(springpot_rows(root, bench, args.fmu, args.largest_n))
+    write(args.out / "benchmarks.md", steps, impacts, g1, -0.5, package, springpot)
     print((args.out / "benchmarks.md").read_text())
 
