@@ -1,0 +1,390 @@
+"""The springpot damper F = c_alpha D^alpha x2 (issue 12, MODEL.md §7-§8) and
+the general spring exponent n, against what is known independently of the C
+code: closed forms (the power rule, the fractional Maxwell model's
+Mittag-Leffler function computed here with mpmath, the elastic contact time
+of k x1^n), the dashpot model at alpha = 1, the GSL reference, identities
+(energy, impulse, passivity), the exact kernel, and the other memory.
+
+Every tolerance is derived in a comment from the method's known error:
+
+- memory = 2 (compressed): SDIRK2 (Alexander, gamma = 1 - 1/sqrt 2) on the
+  Prony modes. Its stability function R(z) = (1 + (1 - 2 gamma) z)/(1 - gamma z)^2
+  = e^z + C3 z^3 + C4 z^4 + ..., so a mode b driven at a constant rate is off
+  by n C3 (b h)^3 e^(-b t) after n steps; summed over the kernel's modes this
+  gives the rigid spring's error in closed form (test 1). Where x2'' != 0 the
+  stiff modes (b h > 1, stage order 1) add a term h^(2 - alpha): the
+  compressed memory is of order 2 - alpha, not 2, as h -> 0 (measured, test 2).
+- memory = 1 (full G1 history): the shifted G1 sum (1 + alpha/2) G_n -
+  (alpha/2) G_(n-1), second order, with BDF2 for the striker; for x2 = v t
+  it is an exact Gamma-function ratio (test 1).
+- the kernel tolerance (memory_tolerance, default 1e-6) bounds the kernel's
+  relative error on [dt_max, 1000 s], and with it the force's.
+"""
+
+import json
+import math
+import os
+import struct
+import subprocess
+
+import mpmath
+import numpy as np
+import pytest
+from fmpy.fmi1 import FMICallException
+from scipy.special import beta as beta_function
+from scipy.special import gamma as gamma_function
+
+import fraccontact
+
+from closed_forms import EPS
+
+# Alexander's SDIRK2 and the Taylor coefficients of R(z) - e^z (MODEL.md's
+# scheme; contact.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
+SDIRK = 1.0 - 1.0 / math.sqrt(2.0)
+C3 = 3 * SDIRK ** 2 - 2 * SDIRK ** 3 - 1.0 / 6.0     # 0.0404401...
+C4 = 4 * SDIRK ** 3 - 3 * SDIRK ** 4 - 1.0 / 24.0    # 0.0367550...
+
+# The driven scene's rate and springpot constant of the closed-form runs.
+V = 0.1       # m/s
+C_ALPHA = 1e3  # N s^alpha/m
+
+
+# --------------------------------------------------------------- references
+
+def mittag_leffler_series(alpha, z):
+    """E_{alpha,2}(z) = sum_j z^j / Gamma(alpha j + 2) by its defining series
+    in mpmath. For z < 0 the terms grow to about exp(|z|^(1/alpha)) before
+    they cancel: that many digits more than the 30 kept. alpha is taken as
+    the double the model uses (mpf(alpha) is exact)."""
+    extra = int(abs(z) ** (1.0 / alpha) / math.log(10)) + 30
+    with mpmath.workdps(extra):
+        a, z = mpmath.mpf(alpha), mpmath.mpf(z)
+        total, j = mpmath.mpf(0), 0
+        while True:
+            term = z ** j / mpmath.gamma(a * j + 2)
+            total += term
+            if j > 10 and abs(term) < mpmath.mpf(10) ** (-extra + 5):
+                return float(total)
+            j += 1
+
+
+def maxwell_g(alpha, lam, t):
+    """t E_{alpha,2}(-lam t^alpha): the inverse Laplace transform of
+    s^(alpha-2)/(s^alpha + lam) (MODEL.md §7), by Talbot's contour in
+    mpmath at 30 digits. F(t) = k v maxwell_g(t) for the linear spring n = 1
+    in series with the springpot driven at v from t = 0."""
+    if t <= 0.0:
+        return 0.0
+    with mpmath.workdps(30):
+        a, lam_ = mpmath.mpf(alpha), mpmath.mpf(lam)
+        return float(mpmath.invertlaplace(lambda s: s ** (a - 2) / (s ** a + lam_), t, method="talbot"))
+
+
+def sdirk2_rigid_ratio(alpha, n):
+    """F_n / (c v t^(1-alpha)/Gamma(2-alpha)) of SDIRK2 on the EXACT kernel
+    after n steps of a rigid spring driven at v (x2 = v t): the kernel
+    t^-alpha/Gamma(1-alpha) = int_0^inf sin(pi alpha)/pi b^(alpha-1) e^(-b t) db
+    is a continuum of modes phi_b' = -b phi_b + v, each of which SDIRK2 takes
+    to v (1 - R(-b h)^n)/b (a constant forcing keeps the fixed point v/b
+    exactly), so with s = b h
+        ratio = n^(alpha-1) Gamma(2-alpha) sin(pi alpha)/pi int_0^inf s^(alpha-2) (1 - R(-s)^n) ds,
+    which is 1 with e^(-s) for R. Quadrature in mpmath at 30 digits: Taylor
+    terms below s0 = 1e-3/n, tanh-sinh in log s up to 1000, the rest
+    S^(alpha-1)/(1-alpha) minus the small R^n part."""
+    with mpmath.workdps(30):
+        a = mpmath.mpf(alpha)
+        g = 1 - 1 / mpmath.sqrt(2)
+
+        def R(s):  # R(-s)
+            return (1 - (1 - 2 * g) * s) / (1 + g * s) ** 2
+
+        s0, S = mpmath.mpf("1e-3") / n, mpmath.mpf(1000)
+        taylor = mpmath.taylor(lambda s: 1 - R(s) ** n, 0, 10)
+        head = sum(ck * s0 ** (a - 1 + k) / (a - 1 + k) for k, ck in enumerate(taylor) if k >= 1)
+        mid = mpmath.quad(lambda u: mpmath.exp((a - 1) * u) * (1 - R(mpmath.exp(u)) ** n),
+                          mpmath.linspace(mpmath.log(s0), mpmath.log(S), 12))
+        tail = S ** (a - 1) / (1 - a) - mpmath.quad(lambda s: s ** (a - 2) * R(s) ** n, [S, mpmath.inf])
+        return float(n ** (a - 1) * mpmath.gamma(2 - a) * mpmath.sin(mpmath.pi * a) / mpmath.pi * (head + mid + tail))
+
+
+def shifted_g1_rigid_ratio(alpha, j):
+    """F_j / (c v h^(1-alpha)/Gamma(2-alpha)) of memory = 1 for x2 = v t on
+    its grid: G_j = sum_{i<j} w_i x2_(j-i) = v h Gamma(j+1-alpha)/(Gamma(2-alpha) Gamma(j))
+    (MODEL.md §4's straight-line sum with order alpha), F_j = c h^-alpha
+    ((1 + alpha/2) G_j - (alpha/2) G_(j-1)), and the first step (backward
+    Euler, no shift) F_1 = c h^-alpha G_1 = c v h^(1-alpha)."""
+    if j == 1:
+        return math.gamma(2 - alpha)
+    return ((1 + alpha / 2) * math.exp(math.lgamma(j + 1 - alpha) - math.lgamma(j))
+            - (alpha / 2) * math.exp(math.lgamma(j - alpha) - math.lgamma(j - 1)))
+
+
+def observed_order(e_coarse, e_fine):
+    return math.log2(abs(e_coarse / e_fine))
+
+
+@pytest.mark.parametrize("alpha, z", [(0.2, -3.0), (0.3, -3.0), (0.5, -5.0), (0.8, -4.0), (0.5, -0.01)])
+def test_mittag_leffler_by_series_and_by_laplace_inversion_agree(alpha, z):
+    """Two independent routes to the reference: the series at up to 135
+    digits and Talbot's inversion at 30; each rounds once to a double (an ulp
+    each; the talbot integral carries about 1e-25): 4 EPS."""
+    t = 1.0
+    lam = -z
+    assert maxwell_g(alpha, lam, t) == pytest.approx(t * mittag_leffler_series(alpha, z), rel=4 * EPS, abs=0)
+
+
+def test_mittag_leffler_at_alpha_1_is_the_dashpot_exponential():
+    """E_{1,2}(-x) = (1 - e^-x)/x: the Maxwell model's c v (1 - e^(-k t/c))."""
+    lam, t = 3.0, 0.7
+    assert maxwell_g(1.0, lam, t) == pytest.approx(-math.expm1(-lam * t) / lam, rel=4 * EPS, abs=0)
+    assert mittag_leffler_series(1.0, -lam * t) * t == pytest.approx(-math.expm1(-lam * t) / lam, rel=4 * EPS, abs=0)
+
+
+def test_sdirk2_rigid_ratio_has_the_leading_error_of_r_minus_exp():
+    """The quadrature above against its own asymptotics: e^(-s n) - R(-s)^n
+    = n C3 s^3 e^(-s n) (1 + (1 - C4/C3) s) + O(n^2 s^6), whose moments
+    give ratio - 1 = C3 alpha (1 - alpha^2) rho^2 (1 + (1 - C4/C3)(alpha + 2) rho)
+    + O(rho^4), rho = 1/n. The remainder: relative O(rho^2) with coefficient
+    (alpha+2)(alpha+3)(alpha+4) C3/2 < 1.3: bound 1.3 rho^2 of the leading term."""
+    for alpha in (0.2, 0.5, 0.8):
+        for n in (20, 50, 200):
+            rho = 1.0 / n
+            lead = C3 * alpha * (1 - alpha ** 2) * rho ** 2
+            pred = lead * (1 + (1 - C4 / C3) * (alpha + 2) * rho)
+            assert sdirk2_rigid_ratio(alpha, n) - 1 == pytest.approx(pred, abs=1.3 * lead * rho ** 2, rel=0)
+
+
+# ------------------------------------------- 1. a rigid spring: x2 = v t
+
+# A linear spring (n = 1, law = 2) of k = 1e30 N/m in series: x1 = F/k is
+# 1e-30 of x, so x2 = v t to 1e-27 relative (the fractional Maxwell
+# correction Gamma(2-alpha)/Gamma(2-2alpha) (c/k) t^-alpha is 1e-24 at t = 1e-5 s).
+RIGID = dict(scene=2, m=0.0, v=V, damper=2, c_alpha=C_ALPHA, spring_exponent=1, law=2, k=1e30)
+
+
+def rigid_rows(alpha, memory, h, n_end, every, **extra):
+    s = fraccontact.simulate(output_interval=every * h, damper_order=alpha, memory=memory, dt_max=h,
+                             t_end=n_end * h, **RIGID, **extra)
+    t, F = s["t"][1:], s["F"][1:]
+    return t, F, np.rint(t / h).astype(int)
+
+
+def power_rule(alpha, t):
+    """MODEL.md §7: F = c_alpha v t^(1-alpha)/Gamma(2-alpha) for x2 = v t."""
+    return C_ALPHA * V * t ** (1 - alpha) / math.gamma(2 - alpha)
+
+
+@pytest.mark.parametrize("alpha", [0.2, 0.5, 0.8])
+def test_rigid_spring_compressed_memory_is_sdirk2_on_the_exact_kernel(alpha):
+    """memory = 2 against the power rule. Two parts of its error: SDIRK2's,
+    known exactly (sdirk2_rigid_ratio, the exact kernel); and the kernel's
+    sum of exponentials, whose relative error is at most memory_tolerance
+    on [dt_max, 1000 s] (test 6). The lumped dashpot eta stands for the modes
+    faster than the kernel's cut x/dt_max (x ~ 20): exact once R(-s)^n
+    vanishes there, |R(-x)| <= (1-2g)/(g^2 x) ~ 0.25: from n = 20 it is
+    below 1e-12. So F/(power rule x SDIRK2's ratio) - 1 is within the
+    tolerance (measured at most 0.22 of it, alpha = 0.8; 1e-6 default).
+    The closed form is then met with SDIRK2's leading error and its next
+    term (test_sdirk2_rigid_ratio_has_the_leading_error_of_r_minus_exp):
+    C3 alpha (1-alpha^2) (h/t)^2 is 3.9e-5 to 5.8e-5 at n = 20."""
+    h, tol = 1e-5, 1e-6
+    t, F, n = rigid_rows(alpha, 2, h, 100, 20)
+    assert list(n) == [20, 40, 60, 80, 100]
+    for ti, Fi, ni in zip(t, F, n):
+        ratio = sdirk2_rigid_ratio(alpha, int(ni))
+        assert Fi / (power_rule(alpha, ti) * ratio) - 1 == pytest.approx(0, abs=tol)
+        rho = h / ti
+        lead = C3 * alpha * (1 - alpha ** 2) * rho ** 2
+        pred = lead * (1 + (1 - C4 / C3) * (alpha + 2) * rho)
+        assert Fi / power_rule(alpha, ti) - 1 == pytest.approx(pred, abs=1.3 * lead * rho ** 2 + tol, rel=0)
+
+
+@pytest.mark.parametrize("alpha", [0.2, 0.5, 0.8])
+def test_rigid_spring_full_history_is_the_shifted_g1_sum(alpha):
+    """memory = 1 against the exact Gamma-function value of its own scheme
+    (shifted_g1_rigid_ratio) at every step: the G1 sum of j terms is
+    compensated (a few ulp), h^alpha and the stage's solve a few more; the
+    power rule's F is the difference of two terms (t/h)^alpha ~ 40 times
+    larger at j = 100, alpha = 0.8: 40 x 8 EPS ~ 7e-14 (measured 1.7e-13 with
+    lgamma's rounding in the prediction): 1e-12.
+    And against the power rule: the shift cancels G1's 1/j term, leaving
+    alpha (1-alpha^2)(2+3 alpha)/24 / j^2 (expanding Gamma(j+a)/Gamma(j)
+    to 1/j^2), times 1 + c/j + ...: c = 0.203, 0.536, 0.916 for alpha = 0.2,
+    0.5, 0.8 (the exact ratio in mpmath at j = 1e6), at most 0.994 at j >= 10:
+    rel = 1/j. The observed order between j and 2j is then 2 + log2((1 +
+    c/j)/(1 + c/2j)) ~ 2 + c/(2 j ln 2): |p - 2| <= 1/(j ln 2)."""
+    h = 1e-5
+    t, F, n = rigid_rows(alpha, 1, h, 100, 1)
+    err = {}
+    for ti, Fi, ji in zip(t, F, n):
+        ji = int(ji)
+        predicted = C_ALPHA * V * h ** (1 - alpha) / math.gamma(2 - alpha) * shifted_g1_rigid_ratio(alpha, ji)
+        assert Fi == pytest.approx(predicted, rel=1e-12, abs=0)
+        err[ji] = Fi / power_rule(alpha, ti) - 1
+    lead = alpha * (1 - alpha ** 2) * (2 + 3 * alpha) / 24
+    for j in (10, 25, 50):
+        assert err[j] == pytest.approx(lead / j ** 2, rel=1.0 / j)
+        assert observed_order(err[j], err[2 * j]) == pytest.approx(2.0, abs=1.0 / (j * math.log(2)))
+
+
+# ------------------------- 2. a linear spring in series: fractional Maxwell
+
+# n = 1 (law = 2) and the springpot driven at V from t = 0 over T = 2 ms,
+# k = 3 c_alpha / T^alpha so that lambda T^alpha = 3: the force has relaxed
+# well away from the spring's k v t by the end. memory_tolerance = 1e-10
+# keeps the kernel's share (<= 1e-10 of F) far below the discretisation
+# errors being measured (>= 1e-9).
+MAXWELL_T = 2e-3
+
+
+def maxwell_k(alpha):
+    return 3.0 * C_ALPHA / MAXWELL_T ** alpha
+
+
+def maxwell_run(alpha, memory, steps, every=MAXWELL_T / 16):
+    """F at the rows every T/16 from T/4 to T (read where they fall: memory =
+    1 may end a step past t_end, its time a sum of steps), and those times."""
+    k = maxwell_k(alpha)
+    s = fraccontact.simulate(output_interval=every, scene=2, m=0.0, v=V, damper=2, damper_order=alpha,
+                             c_alpha=C_ALPHA, memory=memory, spring_exponent=1, law=2, k=k,
+                             dt_max=MAXWELL_T / steps, t_end=MAXWELL_T, memory_tolerance=1e-10)
+    keep = s["t"] > MAXWELL_T / 4 - 1e-9
+    return s["t"][keep], s["F"][keep]
+
+
+def maxwell_error(alpha, memory, steps):
+    """The largest relative error over [T/4, T] (a norm: the error of either
+    memory changes sign somewhere in t, where a pointwise order means nothing)."""
+    k = maxwell_k(alpha)
+    t, F = maxwell_run(alpha, memory, steps)
+    exact = np.array([k * V * maxwell_g(alpha, k / C_ALPHA, ti) for ti in t])
+    return np.max(abs(F / exact - 1))
+
+
+# Bands for the observed order of the largest error over [T/4, T] between
+# T/400 and T/800, from theory and what it leaves open:
+# - memory = 2: error A h^2 + B h^(2-alpha) (SDIRK2 plus its stiff modes'
+#   order reduction where x2'' != 0; test_compressed_memory_error_is_...):
+#   an order between 2 - alpha and 2, approaching 2 - alpha; measured 2.00
+#   (alpha 0.2), 1.87 (0.5), 1.37 (0.8), 2.00 (alpha = 1: a dashpot, no modes).
+# - memory = 1: second order (test 1), approached from below by the start's
+#   nonsmooth x2 ~ t^(1+alpha) (alpha 0.5: 1.80, 1.84, 1.88, 1.91 from T/100
+#   to T/1600); measured 2.09 (0.2), 1.88 (0.5), 1.99 (0.8), 2.00 (1): [1.8, 2.2].
+@pytest.mark.parametrize("memory", [1, 2])
+@pytest.mark.parametrize("alpha", [0.2, 0.5, 0.8, 1.0])
+def test_linear_spring_meets_the_mittag_leffler_force_at_the_measured_order(alpha, memory):
+    """F(t) = k v t E_{alpha,2}(-(k/c_alpha) t^alpha) (MODEL.md §7): an
+    error that falls at the scheme's order proves the limit (a wrong closed
+    form would leave a floor, and an order near 0)."""
+    coarse, fine = maxwell_error(alpha, memory, 400), maxwell_error(alpha, memory, 800)
+    low, high = (2 - alpha - 0.1, 2.1) if memory == 2 and alpha < 1 else (1.8, 2.2)
+    order = observed_order(coarse, fine)
+    print(f"Maxwell alpha {alpha} memory {memory}: max error {coarse:.2e} (T/400), {fine:.2e} (T/800), order {order:.2f}")
+    assert low <= order <= high
+    # and small: the largest measured at T/800 is 6.2e-6 (memory 1, alpha 1)
+    assert fine < 1e-5
+
+
+def test_linear_spring_at_alpha_1_is_the_maxwell_exponential():
+    """alpha = 1 with memory = 2 is the dashpot (no modes, eta = 1):
+    F = c v (1 - e^(-k t/c)) up to SDIRK2's error, whose observed order
+    from T/400 to T/800 is 2 to within the next term's O(h) (measured 2.00)."""
+    k, c = maxwell_k(1.0), C_ALPHA
+    errors = []
+    for steps in (400, 800):
+        t, F = maxwell_run(1.0, 2, steps)
+        errors.append(np.max(abs(F / (c * V * -np.expm1(-k * t / c)) - 1)))
+    assert observed_order(*errors) == pytest.approx(2.0, abs=0.05)
+
+
+@pytest.mark.parametrize("alpha", [0.5, 0.8, 0.95])
+def test_compressed_memory_error_is_a_h2_plus_b_h_to_2_minus_alpha(alpha):
+    """The compressed memory's order, measured on the Maxwell closed form at
+    T/2 over six steps T/100 ... T/3200: SDIRK2 has stage order 1, so a
+    stiff mode (b h >> 1) tracks x2'/b but misses x2''/b^2; summed over the
+    kernel's modes with weight b^(alpha-1) from 1/h up that is
+    x2'' h^(2-alpha). The error fits A h^2 + B h^(2-alpha) to a fraction of
+    a percent (measured 0.1 %: rounding and the next terms; 2 % allowed),
+    and no single power does (h^2 alone misses by 10 % and more).
+    This is a measured limitation of memory = 2 (designed second order): as
+    h -> 0 its order is 2 - alpha where x2'' != 0."""
+    h, e = [], []
+    k = maxwell_k(alpha)
+    for steps in (100, 200, 400, 800, 1600, 3200):
+        t, F = maxwell_run(alpha, 2, steps, every=MAXWELL_T / 2)
+        h.append(MAXWELL_T / steps / t[0])
+        e.append(F[0] / (k * V * maxwell_g(alpha, k / C_ALPHA, t[0])) - 1)
+    h, e = np.array(h), np.array(e)
+    basis = np.c_[h ** 2, h ** (2 - alpha)]
+    coef, *_ = np.linalg.lstsq(basis / abs(e)[:, None], np.sign(e), rcond=None)
+    assert np.all(abs(e / (basis @ coef) - 1) < 0.02), (e, coef)
+    only_h2, *_ = np.linalg.lstsq((h ** 2 / abs(e))[:, None], np.sign(e), rcond=None)
+    assert np.max(abs(e / (h ** 2 * only_h2[0]) - 1)) > 0.1
+    orders = [observed_order(e[i], e[i + 1]) for i in range(len(e) - 1)]
+    print(f"alpha {alpha}: compressed memory orders T/100..T/3200:", " ".join(f"{p:.2f}" for p in orders))
+    assert orders[-1] < orders[0]          # falling towards 2 - alpha
+    assert orders[-1] > 2 - alpha - 0.05
+
+
+# The drive stops at t1 = T/2 (the FMU's input v set to 0 there, m = 0): x is
+# held from then on, and by superposition F = k v [g(t) - g(t - t1)].
+DRIVE_STOP_XFAIL = pytest.mark.xfail(strict=True, reason=(
+    "model defect: memory = 1 (BDF2 for the striker) ignores a change of the prescribed rate v in the driven "
+    "scene with m = 0: BDF2's second value (the old v) carries on, so after v := 0 the striker drifts "
+    "(v_striker -v/3 on the next internal step, tending to -v/2) and x moves by O(v dt_max) per step"))
+
+
+def driven_slave(slave, alpha, memory, steps):
+    return slave(scene=2, m=0.0, v=V, damper=2, damper_order=alpha, c_alpha=C_ALPHA, memory=memory,
+                 spring_exponent=1, law=2, k=maxwell_k(alpha), dt_max=MAXWELL_T / steps, memory_tolerance=1e-10)
+
+
+def relaxation_error(slave, alpha, memory, steps):
+    """The largest relative error against superposition over (t1, T], at
+    communication points every T/16 (whole multiples of dt_max)."""
+    s = driven_slave(slave, alpha, memory, steps)
+    k, lam, t1, H = maxwell_k(alpha), maxwell_k(alpha) / C_ALPHA, MAXWELL_T / 2, MAXWELL_T / 16
+    worst = 0.0
+    for i in range(16):
+        if i == 8:
+            s.set(v=0.0)
+        s.step(H)
+        if i >= 8:
+            exact = k * V * (maxwell_g(alpha, lam, s.t) - maxwell_g(alpha, lam, s.t - t1))
+            worst = max(worst, abs(s.get("F") / exact - 1))
+    return worst
+
+
+@pytest.mark.parametrize("memory", [2, pytest.param(1, marks=DRIVE_STOP_XFAIL)])
+@pytest.mark.parametrize("alpha", [0.5, 0.8])
+def test_relaxation_after_the_drive_stops_is_superposition(slave, alpha, memory):
+    """The same bands as the loading above (the drive's stop is a new
+    nonsmooth start for the second term); measured (memory 2) orders 1.92
+    (alpha 0.5), 1.38 (0.8), errors 2.5e-7 and 2.2e-6 at T/800."""
+    coarse, fine = relaxation_error(slave, alpha, memory, 400), relaxation_error(slave, alpha, memory, 800)
+    order = observed_order(coarse, fine)
+    print(f"relaxation alpha {alpha} memory {memory}: max error {coarse:.2e}, {fine:.2e}, order {order:.2f}")
+    low, high = (2 - alpha - 0.1, 2.1) if memory == 2 else (1.8, 2.2)
+    assert low <= order <= high
+    assert fine < 1e-5
+
+
+@pytest.mark.parametrize("memory", [2, pytest.param(1, marks=DRIVE_STOP_XFAIL)])
+def test_a_stopped_drive_holds_the_indentation(slave, memory):
+    """m = 0 prescribes the rate: after v := 0 the striker stands still,
+    v_striker = 0 and x = v t1 whatever the damper's memory does inside:
+    x1 and x2 each change by the damper's travel, rounded (an ulp of x2 < x
+    per internal step, at most one per 1e-5 s): N EPS after N steps.
+    Communication steps of 1 and 10 dt_max."""
+    for H in (1e-5, 1e-4):
+        s = slave(scene=2, m=0.0, v=V, damper=2, damper_order=0.5, c_alpha=C_ALPHA, memory=memory,
+                  spring_exponent=1, law=2, k=1e5, dt_max=1e-5)
+        for _ in range(round(1e-3 / H)):
+            s.step(H)
+        held = s.get("x")
+        assert held == pytest.approx(V * 1e-3, rel=1e-12, abs=0)
+        s.set(v=0.0)
+        for i in range(1, round(1e-3 / H) + 1):
+            s.step(H)
+            assert s.get("v_striker") == 0.0
+            assert s.get("x") == pytest.approx(held, rel=i * H / 1e-5 * EPS, abs=0)
