@@ -24,6 +24,7 @@ Every tolerance is derived in a comment from the method's known error:
 import json
 import math
 import os
+import pathlib
 import struct
 import subprocess
 
@@ -37,6 +38,21 @@ from scipy.special import gamma as gamma_function
 import fraccontact
 
 from closed_forms import EPS
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SOLVE = os.environ.get("FRACCONTACT_SOLVE", str(ROOT / "build" / "fraccontact-solve"))
+IMPACT_KEYS = ("F_peak", "eps", "t_contact", "x2_end", "E_diss")
+M_STRIKER, V0 = 0.7437, 0.626418   # the h20 drop test's striker (the defaults)
+
+
+def reference(*args):
+    """GSL's high-accuracy solve of the same drop test (fraccontact-solve
+    --reference, rtol 1e-12): the dashpot model with any spring exponent."""
+    done = subprocess.run([SOLVE, "--reference", "--json", *map(str, args)], capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
 
 # Alexander's SDIRK2 and the Taylor coefficients of R(z) - e^z (MODEL.md's
 # scheme; contact.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
@@ -388,3 +404,190 @@ def test_a_stopped_drive_holds_the_indentation(slave, memory):
             s.step(H)
             assert s.get("v_striker") == 0.0
             assert s.get("x") == pytest.approx(held, rel=i * H / 1e-5 * EPS, abs=0)
+
+
+# -------------------------------- 3. alpha = 1: the springpot is the dashpot
+
+OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "eps", "semi_integral"]
+
+
+@pytest.mark.parametrize("law", [1, 2])
+def test_alpha_1_compressed_memory_is_the_dashpot(slave, law):
+    """At alpha = 1 the kernel is eta = 1 and no modes (test 6): each SDIRK2
+    stage's damper rate is (F - 0)/(c_alpha (1 + 0)), the dashpot's F/c,
+    so every output of the drop test through the contact and the flight
+    after it matches the dashpot model's (damper 1, c = c_alpha) to 1e-9
+    (the issue's figure; x2 sums the same stage rates in another order, a
+    few ulp; measured 3e-15). E_diss: the next test."""
+    common = dict(law=law, dt_max=1e-7)
+    springpot = slave(damper=2, damper_order=1.0, c_alpha=6080.0, memory=2, **common)
+    dashpot = slave(damper=1, c=6080.0, **common)
+    for _ in range(200):   # 2 ms: the contact ends at 1.32 ms
+        springpot.step(1e-5)
+        dashpot.step(1e-5)
+        for name in OUTPUTS:
+            assert springpot.get(name) == pytest.approx(dashpot.get(name), rel=1e-9, abs=0), name
+    assert springpot.get("eps") > 0
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "model: at alpha = 1 E_diss differs from the dashpot's by 7.8e-9 relative at dt_max = 1e-7 (O(h^2): the dashpot "
+    "counts J^2/(c h) per step, the springpot the stages' F x2' by SDIRK2's weights; the springpot's is 3x closer "
+    "to the GSL reference), above the issue's 1e-9"))
+def test_alpha_1_dissipated_energy_is_the_dashpots_to_1e_9():
+    springpot = fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=2, law=2)
+    dashpot = fraccontact.impact(damper=1, c=3e5, law=2)
+    assert springpot.E_diss == pytest.approx(dashpot.E_diss, rel=1e-9, abs=0)
+
+
+def test_alpha_1_dissipated_energy_converges_with_the_dashpots():
+    """Both counts of E_diss (the dashpot's J^2/(c h), the springpot's stage
+    quadrature) are second order: their errors against the GSL reference
+    fall 4x per halving (order 2 +- 0.1, measured 2.00 and 1.99) and at
+    dt_max = 1e-7 are 1.17e-8 and 3.9e-9 (c = 3e5: little damping)."""
+    ref = reference("--c", 3e5, "--law", 2)
+    for run in (lambda dt: fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=2, law=2, dt_max=dt),
+                lambda dt: fraccontact.impact(damper=1, c=3e5, law=2, dt_max=dt)):
+        e = [run(dt).E_diss / ref["E_diss"] - 1 for dt in (1e-6, 5e-7)]
+        assert observed_order(*e) == pytest.approx(2.0, abs=0.1)
+
+
+def test_alpha_1_full_history_is_second_order_to_the_dashpot_reference():
+    """memory = 1 at alpha = 1 is BDF2 (G1 of order 1 is the backward
+    difference, its shift makes it BDF2's), not SDIRK2: the dashpot model's
+    solution only in the limit. Against the GSL reference, errors at dt_max =
+    1e-6, 5e-7, 2.5e-7 fall at least at order 2 (measured: t_contact and
+    E_diss 2.0, eps 2.7, x2_end 2.8-3.0, F_peak 1.8 and 2.4: it is sampled
+    at the grid's points, the peak between them missed by O(h^2) with the
+    grid's phase): every observed order >= 1.7; and the error at 2.5e-7 lies
+    within the Richardson bound |Q(h) - Q(h/2)|/(2^1.7 - 1) that such an
+    order implies (it is 1.2e-7 relative at most, F_peak's)."""
+    ref = reference("--c", 3e5, "--law", 2)
+    runs = [fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=1, law=2, dt_max=dt)
+            for dt in (1e-6, 5e-7, 2.5e-7)]
+    for key in IMPACT_KEYS:
+        q = [getattr(r, key) for r in runs]
+        e = [x / ref[key] - 1 for x in q]
+        assert observed_order(e[0], e[1]) >= 1.7, (key, e)
+        assert observed_order(e[1], e[2]) >= 1.7, (key, e)
+        assert abs(e[2]) <= abs(q[1] - q[2]) / abs(ref[key]) / (2 ** 1.7 - 1), (key, e)
+
+
+# ------------------------ 4. the drop test's identities with a springpot
+
+def spring_k(n):
+    """A spring k x1^n as stiff as the h20 test's Hertz spring at x1 = 80 um."""
+    return 3.299e8 * 8e-5 ** (1.5 - n)
+
+
+def equivalent_c_alpha(alpha, c=6080.0, omega=2400.0):
+    """A springpot as damping as the h20 dashpot at the impact's frequency
+    pi/t_c (the default c_alpha's rule, contact.c): c_alpha omega^alpha = c omega."""
+    return c * omega ** (1 - alpha)
+
+
+def identity_defects(slave, n, memory, dt_max, H=1e-5, t_end=2.5e-3):
+    """Through the impact and the recovery after it (g = 0), at every
+    communication point: the energy defect |1/2 m v0^2 - 1/2 m v^2 - k
+    x1^(n+1)/(n+1) - E_diss| / (1/2 m v0^2), the impulse defect |m (v0 - v)
+    - sum F_avg H| / (m v0), and E_diss, contact."""
+    k = spring_k(n)
+    s = slave(damper=2, memory=memory, spring_exponent=n, law=2, k=k, dt_max=dt_max)
+    E0, impulse, rows = 0.5 * M_STRIKER * V0 ** 2, 0.0, []
+    while s.t < t_end - 1e-12:
+        s.step(H)
+        impulse += s.get("F_avg") * H
+        v, x1, E = s.get("v_striker"), s.get("x1"), s.get("E_diss")
+        rows.append((abs(0.5 * M_STRIKER * v * v + k * x1 ** (n + 1) / (n + 1) + E - E0) / E0,
+                     abs(M_STRIKER * (V0 - v) - impulse) / (M_STRIKER * V0), E, s.get("contact")))
+    return np.array(rows)
+
+
+@pytest.mark.parametrize("memory", [1, 2])
+@pytest.mark.parametrize("n", [1.0, 1.5, 2.0])
+def test_energy_and_impulse_identities_of_a_springpot_drop(slave, n, memory):
+    """1/2 m v0^2 = 1/2 m v^2 + k x1^(n+1)/(n+1) + int F dx2 and m (v0 - v)
+    = int F dt (MODEL.md §7, no gravity). Neither scheme conserves energy
+    exactly: the defect is its error, second order, so the largest over the
+    run falls 4x from dt_max = 1e-6 to 5e-7 (order 2 +- 0.2; measured 1.97-
+    2.00, defects 1.2e-7 to 2.6e-7 at 1e-6 for memory 2 and 4.3e-6 to 6e-6
+    for memory 1, BDF2's error constant being 5x SDIRK2's).
+    Impulse: SDIRK2's velocity update is v - (hb F1 + hg F2)/m, exactly the
+    impulse F_avg H reports, so memory 2 holds it to rounding: an ulp of v0
+    per internal step (2500 at most to 2.5 ms), measured 4e-15. Memory 1
+    reports the trapezoidal impulse while BDF2 moves v: order 2 as above
+    (measured 2.0, 1.5e-6 to 2.9e-6 at 1e-6)."""
+    coarse = identity_defects(slave, n, memory, 1e-6)
+    fine = identity_defects(slave, n, memory, 5e-7)
+    energy = observed_order(coarse[:, 0].max(), fine[:, 0].max())
+    print(f"n {n} memory {memory}: energy defect {coarse[:, 0].max():.2e} -> {fine[:, 0].max():.2e} "
+          f"(order {energy:.2f}), impulse defect {coarse[:, 1].max():.2e}")
+    assert energy == pytest.approx(2.0, abs=0.2)
+    if memory == 2:
+        assert coarse[:, 1].max() <= 2500 * EPS
+        assert fine[:, 1].max() <= 5000 * EPS
+    else:
+        assert observed_order(coarse[:, 1].max(), fine[:, 1].max()) == pytest.approx(2.0, abs=0.2)
+    assert coarse[-1, 3] == 0 and fine[-1, 3] == 0   # the impact ended
+
+
+@pytest.mark.parametrize("memory", [1, 2])
+@pytest.mark.parametrize("n", [1.0, 1.5, 2.0])
+@pytest.mark.parametrize("alpha", [0.2, 0.5, 0.9])
+def test_a_springpot_is_passive(slave, alpha, n, memory):
+    """int F dx2 >= 0 at every communication point (the kernel is completely
+    monotone: a Maxwell network of positive springs and dashpots, test 6,
+    stores at most what was put in). Unlike a dashpot's it may fall, by what
+    the springpot gives back while x2 falls under load (measured at most
+    44-47 % of its peak at alpha 0.2, 9-11 % at 0.5, 0.1 % at 0.9, alike for
+    both memories); after the separation F = 0 and it stays fixed, bit for
+    bit. c_alpha as damping as the h20 dashpot at the impact's frequency."""
+    k = spring_k(n)
+    s = slave(damper=2, damper_order=alpha, c_alpha=equivalent_c_alpha(alpha), memory=memory, spring_exponent=n,
+              law=2, k=k, dt_max=1e-6)
+    E, contact = [], []
+    while s.t < 2.5e-3 - 1e-12:
+        s.step(1e-5)
+        E.append(s.get("E_diss"))
+        contact.append(s.get("contact"))
+    E = np.array(E)
+    assert np.all(E >= 0)
+    separated = contact.index(False, contact.index(True))
+    assert np.all(E[separated:] == E[separated])
+    print(f"alpha {alpha} n {n} memory {memory}: E_diss falls by at most {largest_fall(E):.3f} of its peak")
+
+
+def largest_fall(E):
+    return np.max(np.maximum.accumulate(E) - E) / E.max()
+
+
+@pytest.mark.parametrize("memory", [1, 2])
+def test_what_a_springpot_gives_back_shrinks_to_nothing_at_alpha_1(slave, memory):
+    """The energy a springpot stores and returns (the fall of int F dx2)
+    comes from its spring-like part: the fall shrinks as alpha grows (the
+    loss angle alpha pi/2 grows; measured 0.46, 0.10, 0.0013) and vanishes
+    at alpha = 1, exactly: memory 2's stages add F x2' = F^2/c >= 0; memory
+    1 adds (F_j + F_(j-1))/2 (x2_j - x2_(j-1)), and its shifted G1 of order
+    1 is BDF2, x2_j - x2_(j-1) = (2/3) h F_j/c + (x2_(j-1) - x2_(j-2))/3 >= 0
+    by induction while F >= 0."""
+    falls = []
+    for alpha in (0.2, 0.5, 0.9, 1.0):
+        s = slave(damper=2, damper_order=alpha, c_alpha=equivalent_c_alpha(alpha), memory=memory, law=2,
+                  dt_max=1e-6)
+        E = []
+        while s.t < 2.5e-3 - 1e-12:
+            s.step(1e-5)
+            E.append(s.get("E_diss"))
+        falls.append(largest_fall(np.array(E)))
+    assert falls[0] > falls[1] > falls[2] > falls[3]
+    assert falls[3] == 0.0
+
+
+def test_a_dashpots_dissipation_never_falls(slave):
+    """The dashpot dissipates F^2/c >= 0 at every step: E_diss never falls."""
+    s = slave(damper=1)
+    previous = 0.0
+    for _ in range(200):
+        s.step(1e-5)
+        assert s.get("E_diss") >= previous
+        previous = s.get("E_diss")
