@@ -591,3 +591,92 @@ def test_a_dashpots_dissipation_never_falls(slave):
         s.step(1e-5)
         assert s.get("E_diss") >= previous
         previous = s.get("E_diss")
+
+
+# -------------- 5. orders of convergence of an h20 springpot impact
+
+def springpot_impact(memory, dt_max, **extra):
+    """The paper's h20 drop test with the default springpot (alpha 0.5,
+    c_alpha 3e5), the closed-form spring (law 2: no step-count effect),
+    kernel tolerance 1e-10 (its error far below the ones measured)."""
+    return fraccontact.impact(damper=2, memory=memory, dt_max=dt_max, law=2, **{"memory_tolerance": 1e-10, **extra})
+
+
+@pytest.fixture(scope="module")
+def fine_impacts():
+    """Each memory's fine-step result, the other's reference: memory 1 at
+    6.25e-8 and 3.125e-8 s extrapolated (its order 2 measured: differences
+    fall 4.0x), memory 2 at 7.8125e-9 s (error ~3e-11 by its measured order)."""
+    m1 = [springpot_impact(1, dt) for dt in (6.25e-8, 3.125e-8)]
+    m1_limit = {key: getattr(m1[1], key) + (getattr(m1[1], key) - getattr(m1[0], key)) / 3
+                for key in ("F_peak", "eps", "t_contact", "E_diss")}
+    return {1: m1_limit, 2: springpot_impact(2, 7.8125e-9)}
+
+
+def impact_orders(memory, reference, keys, steps):
+    errors = {key: [] for key in keys}
+    for dt in steps:
+        r = springpot_impact(memory, dt)
+        for key in keys:
+            ref = reference[key] if isinstance(reference, dict) else getattr(reference, key)
+            errors[key].append(getattr(r, key) / ref - 1)
+    for key in keys:
+        e = errors[key]
+        print(f"memory {memory} {key}: errors", " ".join(f"{x:.2e}" for x in e), " orders",
+              " ".join(f"{observed_order(e[i], e[i + 1]):.2f}" for i in range(len(e) - 1)))
+    return errors
+
+
+def test_compressed_memory_impact_converges_to_the_full_history(fine_impacts):
+    """memory 2 against memory 1's extrapolated fine result (which agrees
+    with memory 2's own finest to 1e-10 in these figures). Its error is
+    A h^2 + B h^(3/2) (alpha = 0.5, test 2), so the observed order lies near
+    [1.5, 2], below 1.5 while the two terms still cancel; measured from
+    dt_max 2.5e-7 to 6.25e-8: F_peak 1.33, 1.42 and E_diss 1.44, 1.47 rising
+    to 1.5, t_contact 1.89, 1.81 falling to it: band [1.2, 2.1]. (eps crosses
+    zero near 3e-7 s and is left out: its error is below 1e-9 there.)"""
+    errors = impact_orders(2, fine_impacts[1], ("F_peak", "t_contact", "E_diss"), (2.5e-7, 1.25e-7, 6.25e-8))
+    for key, e in errors.items():
+        for i in range(2):
+            assert 1.2 <= observed_order(e[i], e[i + 1]) <= 2.1, (key, e)
+
+
+def test_full_history_impact_converges_to_the_compressed_memory(fine_impacts):
+    """memory 1 against memory 2's fine result: second order, measured from
+    dt_max 5e-7 to 1.25e-7: eps 1.93, 1.95, t_contact 2.07, 1.94, E_diss
+    2.02, 2.02: band [1.8, 2.2]. F_peak is sampled at memory 1's grid
+    points (no located peak): its error adds up to F (pi h/t_c)^2/8 that
+    moves with the grid's phase (printed, not asserted: measured 6.0e-7,
+    1.3e-7, 4.1e-8, orders 2.25, 1.62; F_peak is checked at the default step
+    by the next test)."""
+    steps = (5e-7, 2.5e-7, 1.25e-7)
+    errors = impact_orders(1, fine_impacts[2], ("eps", "t_contact", "E_diss", "F_peak"), steps)
+    for key in ("eps", "t_contact", "E_diss"):
+        e = errors[key]
+        for i in range(2):
+            assert 1.8 <= observed_order(e[i], e[i + 1]) <= 2.2, (key, e)
+
+
+def test_the_memories_agree_at_the_default_step():
+    """The issue's figure: F_peak and eps of both memories within 1e-4 at the
+    default dt_max (1e-7) and memory_tolerance (1e-6). The difference is
+    bounded by the kernel's error (the force's relative error <= the
+    tolerance, test 1) plus both schemes' errors at 1e-7 (at most 4e-8
+    relative by the orders above): 1.04e-6 (measured 1.5e-8 and 8.5e-9)."""
+    m1 = fraccontact.impact(damper=2, memory=1, law=2)
+    m2 = fraccontact.impact(damper=2, memory=2, law=2)
+    for key in ("F_peak", "eps", "t_contact"):
+        assert getattr(m2, key) == pytest.approx(getattr(m1, key), rel=1.04e-6, abs=0), key
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "model defect: memory = 1 reports x2_end as x2 at the first grid point after the separation, not at the "
+    "separation time it interpolates for t_contact; the dent recovers fast there, so x2_end is off by up to "
+    "dt_max |x2'| (6.8e-4 relative at dt_max = 1e-6, 1.5e-4 at 2.5e-7 in the h20 springpot), first order with "
+    "the grid's phase"))
+def test_full_history_reports_the_dent_at_the_separation(fine_impacts):
+    """x2_end of memory 1 against memory 2's (which locates the separation
+    and stops there): second order, so within 1e-6 at dt_max = 5e-7 (memory
+    1's other figures are within 3e-7 there)."""
+    r = springpot_impact(1, 5e-7)
+    assert r.x2_end == pytest.approx(fine_impacts[2].x2_end, rel=1e-6, abs=0)
