@@ -680,3 +680,112 @@ def test_full_history_reports_the_dent_at_the_separation(fine_impacts):
     1's other figures are within 3e-7 there)."""
     r = springpot_impact(1, 5e-7)
     assert r.x2_end == pytest.approx(fine_impacts[2].x2_end, rel=1e-6, abs=0)
+
+
+# ------------------------------------- 6. the compressed kernel's own error
+
+SPAN = 1e3  # the kernel holds its tolerance from dt_max to 1000 s (contact.h)
+
+
+def kernel_error(alpha, tol, dt_max, points=20000):
+    """The largest relative error of sum_i a_i exp(-b_i tau) against
+    tau^-alpha/Gamma(1-alpha) on a log grid of `points` over [dt_max, 1000 s]
+    (the error oscillates with the trapezoidal rule's period du in log rate,
+    0.2-0.6: 20000 points over 10 decades put 60-200 in each period, and
+    40000 find the same maximum to 1e-3 of it), and M."""
+    a, b, eta = fraccontact.memory_kernel(damper=2, damper_order=alpha, memory_tolerance=tol, dt_max=dt_max)
+    tau = np.logspace(math.log10(dt_max), math.log10(SPAN), points)
+    approx = np.exp(-np.outer(tau, b)) @ a
+    exact = tau ** -alpha / gamma_function(1 - alpha)
+    return np.max(abs(approx / exact - 1)), len(a)
+
+
+@pytest.mark.parametrize("tol", [1e-4, 1e-6, 1e-9])
+@pytest.mark.parametrize("alpha", [0.05, 0.3, 0.5, 0.8, 0.95, 0.999])
+def test_the_kernel_holds_its_tolerance_over_the_span(alpha, tol):
+    """The kernel's relative error on [dt_max, 1000 s] at the default dt_max
+    (1e-7, a span of 1e10) is within memory_tolerance: measured 0.40 to 0.74
+    of it (soe.c gives a third of it to each of the rule's aliasing, the fast
+    cut and the lumped spring). M for these: 28-41 (1e-4), 48-61 (1e-6),
+    87-94 (1e-9)."""
+    error, M = kernel_error(alpha, tol, 1e-7)
+    print(f"alpha {alpha} tol {tol:g}: M = {M}, max relative error {error:.2e} ({error / tol:.2f} of tol)")
+    assert error <= tol
+    assert kernel_error(alpha, tol, 1e-7, 40000)[0] == pytest.approx(error, rel=1e-3)
+
+
+@pytest.mark.parametrize("alpha", [0.05, 0.5, 0.999])
+def test_the_kernel_is_a_passive_maxwell_network(alpha):
+    """Every term a positive spring c_alpha a_i with a positive dashpot
+    c_alpha a_i/b_i (b_i > 0, falling), the last a lone spring (b = 0), and a
+    positive lumped dashpot eta: a passive network (test 4's E_diss >= 0).
+    The rates are the trapezoidal rule's nodes e^u, equally spaced in log."""
+    a, b, eta = fraccontact.memory_kernel(damper=2, damper_order=alpha)
+    assert np.all(a > 0) and eta > 0
+    assert b[-1] == 0.0 and np.all(b[:-1] > 0) and np.all(np.diff(b) < 0)
+    ratios = np.log(b[:-2] / b[1:-1])
+    assert np.all(ratios == pytest.approx(ratios[0], rel=1e-12))
+
+
+def test_at_alpha_1_the_kernel_is_the_dashpot():
+    a, b, eta = fraccontact.memory_kernel(damper=2, damper_order=1.0)
+    assert len(a) == 0 and eta == 1.0
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "model defect: for alpha <= 0.03 at memory_tolerance = 1e-2 (accepted by the parameter check) soe_kernel "
+    "returns one term a = NaN, eta = NaN (the fixed-point iterations' logarithms of a negative number)"))
+@pytest.mark.parametrize("alpha", [0.01, 0.03])
+def test_the_kernel_holds_at_the_loosest_tolerance(alpha):
+    error, M = kernel_error(alpha, 1e-2, 1e-7)
+    assert error <= 1e-2
+
+
+def test_the_number_of_modes_grows_like_the_log_of_the_span():
+    """The rule's nodes are du apart in log rate over [about 1/dt_max,
+    about tol^(1/(1+alpha))/1000 s]: M = ln(1000 s/dt_max)/du + a constant,
+    so ten times the span adds ln(10)/du modes, up to one for where the
+    ends fall (alpha 0.5, tol 1e-6: du = 0.21, 10.8 per decade)."""
+    a, b, _ = fraccontact.memory_kernel(damper=2, damper_order=0.5, memory_tolerance=1e-6)
+    du = math.log(b[0] / b[1])
+    counts = [len(fraccontact.memory_kernel(damper=2, damper_order=0.5, memory_tolerance=1e-6,
+                                            dt_max=10.0 ** -e)[0]) for e in range(2, 10)]
+    for fewer, more in zip(counts, counts[1:]):
+        assert abs(more - fewer - math.log(10) / du) <= 1.0, counts
+
+
+# MODEL.md §8: the published number of exponentials for tau^(-1/2) on
+# [delta, T] (Jiang, Zhang, Zhang & Zhang 2017), by relative accuracy and
+# delta/T; ours spans [dt_max, 1000 s], so dt_max = 1000 delta/T. Measured
+# (alpha 0.5, ours counting the lumped spring; the lumped dashpot eta has no
+# state):
+#   accuracy   delta/T:  1e-3      1e-4      1e-6      1e-8
+#   1e-6       published 32        37        48        59
+#              ours      32        36        43        50
+#   1e-9       published 45        53        69        85
+#              ours      57        62        73        83
+#   1e-12      published 58        68        90        111
+#              ours      88        95        109       123
+# Ours is within the published counts + 10 % at 1e-6 (fewer from 1e-4 on)
+# and at 1e-9 for delta/T <= 1e-6, not elsewhere: the slow end's lumped spring must reach rates down to
+# tol^(1/(1+alpha))/T, which costs ln(1/tol)/((1+alpha) du) nodes, and du
+# itself shrinks like 1/ln(1/tol); the published method's Gauss-Jacobi
+# quadrature on dyadic intervals does not pay that. At least a 10 % margin
+# is asked where the span ratios match; the cells it misses are xfail
+# (strict), so an improvement of the kernel shows.
+PUBLISHED = {1e-6: (32, 37, 48, 59), 1e-9: (45, 53, 69, 85), 1e-12: (58, 68, 90, 111)}
+SPAN_RATIOS = (1e-3, 1e-4, 1e-6, 1e-8)
+PUBLISHED_MISSED = {(1e-9, 1e-3), (1e-9, 1e-4), (1e-12, 1e-3), (1e-12, 1e-4), (1e-12, 1e-6), (1e-12, 1e-8)}
+
+
+@pytest.mark.parametrize("tol, ratio", [
+    pytest.param(tol, ratio, marks=pytest.mark.xfail(strict=True, reason=(
+        "ours needs more modes than the published count + 10 % at this accuracy and span (table above)")))
+    if (tol, ratio) in PUBLISHED_MISSED else (tol, ratio)
+    for tol in PUBLISHED for ratio in SPAN_RATIOS])
+def test_modes_against_the_published_counts(tol, ratio):
+    published = PUBLISHED[tol][SPAN_RATIOS.index(ratio)]
+    error, M = kernel_error(0.5, tol, SPAN * ratio)
+    print(f"tau^-1/2, accuracy {tol:g}, delta/T {ratio:g}: M = {M} (published {published}), error {error:.2e}")
+    assert error <= tol
+    assert M <= 1.1 * published
