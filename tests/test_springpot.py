@@ -789,3 +789,221 @@ def test_modes_against_the_published_counts(tol, ratio):
     print(f"tau^-1/2, accuracy {tol:g}, delta/T {ratio:g}: M = {M} (published {published}), error {error:.2e}")
     assert error <= tol
     assert M <= 1.1 * published
+
+
+# ------------------------------------------------------ 7. FMU behaviour
+
+STATE_OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
+
+
+def bits(s):
+    return [struct.pack("<d", s.get(name)) for name in STATE_OUTPUTS] + [s.get("contact")]
+
+
+def run_bits(s, n, H=1e-5):
+    rows = []
+    for _ in range(n):
+        s.step(H)
+        rows.append(bits(s))
+    return rows
+
+
+@pytest.mark.parametrize("phase, before", [("mid-contact", 50), ("recovery", 200)])
+@pytest.mark.parametrize("memory", [1, 2])
+def test_state_round_trip_continues_bit_for_bit(slave, memory, phase, before):
+    """Get/set in the instance and serialize/deserialize into a new one of
+    other settings (a dashpot: the state brings the springpot and its
+    memory), mid-contact (0.5 ms) and while the dent recovers (2 ms; the
+    contact ends at 1.42 ms): the next 60 communication steps are the same
+    bits."""
+    a = slave(damper=2, memory=memory, dt_max=1e-6)
+    run_bits(a, before)
+    t = a.t
+    state = a.fmu.getFMUstate()
+    blob = a.fmu.serializeFMUstate(state)
+    print(f"memory {memory} {phase}: state {len(blob)} B at t = {t:.2e} s")
+    expected = run_bits(a, 60)
+    assert expected[0][-1] is (phase == "mid-contact")
+    a.fmu.setFMUstate(state)
+    a.t = t
+    assert run_bits(a, 60) == expected
+    a.fmu.freeFMUstate(state)
+    b = slave(damper=1, c=1000.0, law=2)
+    b.fmu.setFMUstate(b.fmu.deSerializeFMUstate(blob))
+    b.t = t
+    assert run_bits(b, 60) == expected
+
+
+def test_state_sizes(slave):
+    """The compressed memory's state has one size however long the run
+    (measured 808 B at dt_max = 1e-6, M = 58 modes: the modes' stretches and
+    the damper's rate beside the dashpot's 332 B), within the issue's 4 KiB;
+    the full history's grows by a double per internal step since t = 0."""
+    def size(s):
+        return len(s.fmu.serializeFMUstate(s.fmu.getFMUstate()))
+    compressed = slave(damper=2, memory=2, dt_max=1e-6, g=9.81, v=0.05)
+    sizes = [size(compressed)]
+    for H in (5e-4, 3e-3, 0.1):   # in contact, recovering, after impacts under gravity
+        compressed.step(H)
+        sizes.append(size(compressed))
+    assert len(set(sizes)) == 1 and sizes[0] <= 4096, sizes
+    full = slave(damper=2, memory=1, dt_max=1e-6)
+    full.step(5e-4)
+    at_500 = size(full)
+    full.step(1.5e-3)
+    assert size(full) - at_500 == 8 * 1500
+    print(f"state: dashpot {size(slave())} B, compressed {sizes[0]} B, full history {at_500} B after 500 steps")
+
+
+def test_full_history_refuses_a_step_off_its_grid_and_stays_usable(slave):
+    """memory = 1 steps on the grid of dt_max: a communication step that is
+    not a whole number of them is fmi2Error, naming memory = 1 and dt_max;
+    nothing moves, and the instance then runs on exactly as one that never
+    saw the call."""
+    s = slave(damper=2, memory=1, dt_max=1e-6)
+    run_bits(s, 3)
+    before = bits(s)
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(currentCommunicationPoint=s.t, communicationStepSize=1.5e-6)
+    assert "memory = 1" in s.last_error() and "dt_max" in s.last_error(), s.last_error()
+    assert bits(s) == before
+    twin = slave(damper=2, memory=1, dt_max=1e-6)   # (made after: fmpy logs to the newest instance)
+    run_bits(twin, 3)
+    assert run_bits(s, 20, H=2e-6) == run_bits(twin, 20, H=2e-6)
+
+
+def test_full_history_refuses_to_outgrow_its_limit(slave):
+    """At most 1048576 steps of history (contact.h): an advance past them is
+    refused before it starts, naming the limit and memory = 2."""
+    s = slave(damper=2, memory=1, dt_max=1e-6)
+    with pytest.raises(FMICallException):
+        s.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=(1048576 + 1) * 1e-6)
+    assert "1048576" in s.last_error() and "memory = 2" in s.last_error(), s.last_error()
+    assert s.get("x") == 0.0
+    s.step(1e-5)
+    assert s.get("F") > 0
+
+
+@pytest.mark.parametrize("name, value, shown", [
+    ("damper", 3, "damper = 3"), ("damper", 0, "damper = 0"),
+    ("damper_order", 0.0, "damper_order = 0"), ("damper_order", 1.5, "damper_order = 1.5"),
+    ("damper_order", math.nan, "damper_order = nan"), ("damper_order", -0.5, "damper_order = -0.5"),
+    ("c_alpha", 0.0, "c_alpha = 0"), ("c_alpha", -3e5, "c_alpha = -300000"), ("c_alpha", math.inf, "c_alpha = inf"),
+    ("memory", 3, "memory = 3"), ("memory", 0, "memory = 0"),
+    ("memory_tolerance", 1.0, "memory_tolerance = 1"), ("memory_tolerance", 0.0, "memory_tolerance = 0"),
+    ("spring_exponent", 0.5, "spring_exponent = 0.5")])
+def test_bad_springpot_parameters_are_refused_by_name(slave, name, value, shown):
+    """fmi2Error, the variable and its value named, the old value kept, and
+    the instance still runs an impact."""
+    s = slave(start=False)
+    s.enter()
+    before = s.get(name)
+    with pytest.raises(FMICallException):
+        s.set(**{name: value})
+    assert shown in s.last_error(), s.last_error()
+    assert s.get(name) == before
+    s.fmu.exitInitializationMode()
+    for _ in range(200):
+        s.step(1e-5)
+    assert s.get("eps") > 0
+
+
+def test_too_many_modes_are_refused_naming_the_tolerance(slave):
+    """A kernel of more than 160 modes (tolerance 1e-13 over a span of 1e12
+    needs about 190) is refused at initialization, naming memory_tolerance."""
+    s = slave(start=False, damper=2, memory=2, dt_max=1e-9)
+    s.enter()
+    with pytest.raises(FMICallException):
+        s.set(memory_tolerance=1e-13)
+        s.fmu.exitInitializationMode()
+    assert "memory_tolerance" in s.last_error() and "160" in s.last_error(), s.last_error()
+
+
+@pytest.mark.parametrize("order", ["k first", "n first"])
+def test_k_0_is_hertz_only(slave, order):
+    """k = 0 derives the Hertz constant of a sphere (n = 1.5): with n = 2
+    it is refused, in either order, naming both."""
+    s = slave(start=False)
+    s.enter()
+    first, second = ({"k": 0.0}, {"spring_exponent": 2.0}) if order == "k first" else \
+        ({"spring_exponent": 2.0}, {"k": 0.0})
+    s.set(**first)
+    with pytest.raises(FMICallException):
+        s.set(**second)
+    message = s.last_error()
+    assert "k = 0" in message and "spring_exponent = 2" in message, message
+
+
+@pytest.mark.parametrize("damper, memory", [(1, 2), (2, 1), (2, 2)])
+def test_the_dent_recovers_after_a_springpot_impact_and_stays_after_a_dashpot(slave, damper, memory):
+    """After the separation F = 0: a springpot's D^alpha x2 = 0 forces x2
+    to fall (the dent recovers, both memories, monotonically); a dashpot's
+    x2' = F/c = 0 holds it, bit for bit."""
+    s = slave(damper=damper, memory=memory, dt_max=1e-6)
+    while s.get("eps") == 0.0:
+        s.step(1e-5)
+    x2 = []
+    for _ in range(100):
+        s.step(1e-4)
+        x2.append(s.get("x2"))
+    if damper == 1:
+        assert len(set(x2)) == 1
+    else:
+        assert np.all(np.diff(x2) < 0) and x2[-1] < 0.5 * x2[0] and x2[-1] > 0
+
+
+# Repeated impacts under gravity: the h20 striker at 0.05 m/s, g = 9.81,
+# bounces three times in 23 ms (contacts of 2.3-2.6 ms, flights of 7-8 ms),
+# each contact starting where the striker meets the recovered dent.
+GRAVITY = dict(damper=2, law=2, g=9.81, v=0.05)
+
+
+def bounces(slave, memory, dt_max, H=1e-5, t_end=0.0235):
+    """eps of each finished impact, and x2 and v_striker every 0.5 ms."""
+    s = slave(memory=memory, dt_max=dt_max, **GRAVITY)
+    eps, samples, last = [], [], 0.0
+    for i in range(1, round(t_end / H) + 1):
+        s.step(H)
+        if s.get("eps") != last:
+            last = s.get("eps")
+            eps.append(last)
+        if i % 50 == 0:
+            samples.append((s.get("x2"), s.get("v_striker")))
+    return np.array(eps), np.array(samples)
+
+
+def test_repeated_impacts_under_gravity_agree_between_the_memories(slave):
+    """Both memories through three impacts and the recoveries between them,
+    communication steps of 1e-5 s (which bound memory 2's recovery steps,
+    see the next test), dt_max = 2e-6 and 1e-6. Each memory's error is at
+    least first order (measured second), so at 1e-6 it is at most its
+    change from 2e-6: the memories differ by no more than the sum of their
+    changes, per quantity (eps of each impact, x2 and v over the run).
+    Measured: the memories' difference is 0.30-0.40 of that bound."""
+    runs = {(memory, dt): bounces(slave, memory, dt) for memory in (1, 2) for dt in (2e-6, 1e-6)}
+    assert all(len(runs[key][0]) == 3 for key in runs)
+    for i in (0, 1):   # eps, then the samples
+        change = sum(abs(runs[memory, 2e-6][i] - runs[memory, 1e-6][i]) for memory in (1, 2))
+        difference = abs(runs[1, 1e-6][i] - runs[2, 1e-6][i])
+        if i == 1:   # over the run: x2 and v each against their largest change
+            change = change.max(axis=0)
+        assert np.all(difference <= change), (difference, change)
+        print("impacts' eps" if i == 0 else "x2, v samples", "difference / bound:",
+              np.max(difference / change, axis=0))
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "model limitation: memory 2 steps a recovering dent at 1/8 of the time since separation (RECOVERY_STEP_FRACTION), "
+    "whatever dt_max, when no communication step bounds it: the second impact's eps is 4.7e-6 relative off the "
+    "converged value (library: 0.83232881; FMU with H = 1e-6: 0.83233271; H = 1e-3: 0.83232973) and does not "
+    "fall with dt_max"))
+def test_repeated_impacts_converge_whatever_the_communication_step():
+    """The library's run (no communication steps): memory 2 against memory
+    1, at dt_max 2e-6 and 1e-6, by the same bound as above, on the impacts'
+    eps and onset times."""
+    runs = {(memory, dt): fraccontact.impact(memory=memory, dt_max=dt, impacts=3, **GRAVITY).per_impact
+            for memory in (1, 2) for dt in (2e-6, 1e-6)}
+    for key in ("eps", "t_onset"):
+        value = {k: np.array([getattr(i, key) for i in v]) for k, v in runs.items()}
+        change = sum(abs(value[memory, 2e-6] - value[memory, 1e-6]) for memory in (1, 2))
+        assert np.all(abs(value[1, 1e-6] - value[2, 1e-6]) <= change), key
