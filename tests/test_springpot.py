@@ -160,8 +160,9 @@ def test_sdirk2_rigid_ratio_has_the_leading_error_of_r_minus_exp():
     """The quadrature above against its own asymptotics: e^(-s n) - R(-s)^n
     = n C3 s^3 e^(-s n) (1 + (1 - C4/C3) s) + O(n^2 s^6), whose moments
     give ratio - 1 = C3 alpha (1 - alpha^2) rho^2 (1 + (1 - C4/C3)(alpha + 2) rho)
-    + O(rho^4), rho = 1/n. The remainder: relative O(rho^2) with coefficient
-    (alpha+2)(alpha+3)(alpha+4) C3/2 < 1.3: bound 1.3 rho^2 of the leading term."""
+    + O(rho^4), rho = 1/n. The remainder: relative O(rho^2), its largest
+    part the n^2 s^6 term's (alpha+2)(alpha+3)(alpha+4) C3/2 < 1.3: bound
+    1.3 rho^2 of the leading term."""
     for alpha in (0.2, 0.5, 0.8):
         for n in (20, 50, 200):
             rho = 1.0 / n
@@ -202,7 +203,7 @@ def test_rigid_spring_compressed_memory_is_sdirk2_on_the_exact_kernel(alpha):
     tolerance (measured at most 0.22 of it, alpha = 0.8; 1e-6 default).
     The closed form is then met with SDIRK2's leading error and its next
     term (test_sdirk2_rigid_ratio_has_the_leading_error_of_r_minus_exp):
-    C3 alpha (1-alpha^2) (h/t)^2 is 3.9e-5 to 5.8e-5 at n = 20."""
+    C3 alpha (1-alpha^2) (h/t)^2 is 1.9e-5 to 3.8e-5 at n = 20."""
     h, tol = 1e-5, 1e-6
     t, F, n = rigid_rows(alpha, 2, h, 100, 20)
     assert list(n) == [20, 40, 60, 80, 100]
@@ -221,8 +222,9 @@ def test_rigid_spring_full_history_is_the_shifted_g1_sum(alpha):
     (shifted_g1_rigid_ratio) at every step: the G1 sum of j terms is
     compensated (a few ulp), h^alpha and the stage's solve a few more; the
     power rule's F is the difference of two terms (t/h)^alpha ~ 40 times
-    larger at j = 100, alpha = 0.8: 40 x 8 EPS ~ 7e-14 (measured 1.7e-13 with
-    lgamma's rounding in the prediction): 1e-12.
+    larger at j = 100, alpha = 0.8: 40 x 8 EPS ~ 7e-14; the prediction's
+    exponents carry an ulp of lgamma(100) = 359 each, 6e-14 (measured
+    1.7e-13 in all): 1e-12.
     And against the power rule: the shift cancels G1's 1/j term, leaving
     alpha (1-alpha^2)(2+3 alpha)/24 / j^2 (expanding Gamma(j+a)/Gamma(j)
     to 1/j^2), times 1 + c/j + ...: c = 0.203, 0.536, 0.916 for alpha = 0.2,
@@ -291,14 +293,15 @@ def maxwell_error(alpha, memory, steps):
 def test_linear_spring_meets_the_mittag_leffler_force_at_the_measured_order(alpha, memory):
     """F(t) = k v t E_{alpha,2}(-(k/c_alpha) t^alpha) (MODEL.md §7): an
     error that falls at the scheme's order proves the limit (a wrong closed
-    form would leave a floor, and an order near 0)."""
+    form would leave a floor, and an order near 0); the band's lower edge p
+    bounds the error at T/800 by Richardson's (e(T/400) - e(T/800))/(2^p - 1).
+    Measured errors at T/800: 1.4e-7 to 6.3e-6 (memory 1, alpha 1)."""
     coarse, fine = maxwell_error(alpha, memory, 400), maxwell_error(alpha, memory, 800)
     low, high = (2 - alpha - 0.1, 2.1) if memory == 2 and alpha < 1 else (1.8, 2.2)
     order = observed_order(coarse, fine)
-    print(f"Maxwell alpha {alpha} memory {memory}: max error {coarse:.2e} (T/400), {fine:.2e} (T/800), order {order:.2f}")
+    print(f"Maxwell alpha {alpha} memory {memory}: max error {coarse:.2e} (T/400), {fine:.2e} (T/800), "
+          f"order {order:.2f}")
     assert low <= order <= high
-    # and small: the largest measured at T/800 is 6.2e-6 (memory 1, alpha 1)
-    assert fine < 1e-5
 
 
 def test_linear_spring_at_alpha_1_is_the_maxwell_exponential():
@@ -375,14 +378,14 @@ def relaxation_error(slave, alpha, memory, steps):
 @pytest.mark.parametrize("alpha", [0.5, 0.8])
 def test_relaxation_after_the_drive_stops_is_superposition(slave, alpha, memory):
     """The same bands as the loading above (the drive's stop is a new
-    nonsmooth start for the second term); measured (memory 2) orders 1.92
-    (alpha 0.5), 1.38 (0.8), errors 2.5e-7 and 2.2e-6 at T/800."""
+    nonsmooth start for the second term); measured (memory 2) orders 1.90
+    (alpha 0.5), 1.37 (0.8), errors 1.0e-6 and 2.2e-6 at T/800; memory 1
+    stays 12-13 % off (the xfail's defect)."""
     coarse, fine = relaxation_error(slave, alpha, memory, 400), relaxation_error(slave, alpha, memory, 800)
     order = observed_order(coarse, fine)
     print(f"relaxation alpha {alpha} memory {memory}: max error {coarse:.2e}, {fine:.2e}, order {order:.2f}")
     low, high = (2 - alpha - 0.1, 2.1) if memory == 2 else (1.8, 2.2)
     assert low <= order <= high
-    assert fine < 1e-5
 
 
 @pytest.mark.parametrize("memory", [2, pytest.param(1, marks=DRIVE_STOP_XFAIL)])
@@ -444,7 +447,8 @@ def test_alpha_1_dissipated_energy_converges_with_the_dashpots():
     """Both counts of E_diss (the dashpot's J^2/(c h), the springpot's stage
     quadrature) are second order: their errors against the GSL reference
     fall 4x per halving (order 2 +- 0.1, measured 2.00 and 1.99) and at
-    dt_max = 1e-7 are 1.17e-8 and 3.9e-9 (c = 3e5: little damping)."""
+    dt_max = 1e-7 are 1.17e-8 and 3.9e-9 (c = 3e5: little damping): the
+    issue's 1e-9 between them is out of reach at the default step."""
     ref = reference("--c", 3e5, "--law", 2)
     for run in (lambda dt: fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=2, law=2, dt_max=dt),
                 lambda dt: fraccontact.impact(damper=1, c=3e5, law=2, dt_max=dt)):
@@ -461,7 +465,8 @@ def test_alpha_1_full_history_is_second_order_to_the_dashpot_reference():
     at the grid's points, the peak between them missed by O(h^2) with the
     grid's phase): every observed order >= 1.7; and the error at 2.5e-7 lies
     within the Richardson bound |Q(h) - Q(h/2)|/(2^1.7 - 1) that such an
-    order implies (it is 1.2e-7 relative at most, F_peak's)."""
+    order implies (measured 0.33-0.75 of it; errors 1.6e-9 (x2_end) to
+    4.5e-7 (E_diss) relative)."""
     ref = reference("--c", 3e5, "--law", 2)
     runs = [fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=1, law=2, dt_max=dt)
             for dt in (1e-6, 5e-7, 2.5e-7)]
@@ -509,9 +514,9 @@ def test_energy_and_impulse_identities_of_a_springpot_drop(slave, n, memory):
     """1/2 m v0^2 = 1/2 m v^2 + k x1^(n+1)/(n+1) + int F dx2 and m (v0 - v)
     = int F dt (MODEL.md §7, no gravity). Neither scheme conserves energy
     exactly: the defect is its error, second order, so the largest over the
-    run falls 4x from dt_max = 1e-6 to 5e-7 (order 2 +- 0.2; measured 1.97-
-    2.00, defects 1.2e-7 to 2.6e-7 at 1e-6 for memory 2 and 4.3e-6 to 6e-6
-    for memory 1, BDF2's error constant being 5x SDIRK2's).
+    run falls 4x from dt_max = 1e-6 to 5e-7 (order 2 +- 0.2; measured 1.99-
+    2.03, defects 1.2e-7 to 2.6e-7 at 1e-6 for memory 2 and 4.3e-6 to 6.0e-6
+    for memory 1).
     Impulse: SDIRK2's velocity update is v - (hb F1 + hg F2)/m, exactly the
     impulse F_avg H reports, so memory 2 holds it to rounding: an ulp of v0
     per internal step (2500 at most to 2.5 ms), measured 4e-15. Memory 1
@@ -565,7 +570,7 @@ def largest_fall(E):
 def test_what_a_springpot_gives_back_shrinks_to_nothing_at_alpha_1(slave, memory):
     """The energy a springpot stores and returns (the fall of int F dx2)
     comes from its spring-like part: the fall shrinks as alpha grows (the
-    loss angle alpha pi/2 grows; measured 0.46, 0.10, 0.0013) and vanishes
+    loss angle alpha pi/2 grows; measured 0.46, 0.10, 0.0009) and vanishes
     at alpha = 1, exactly: memory 2's stages add F x2' = F^2/c >= 0; memory
     1 adds (F_j + F_(j-1))/2 (x2_j - x2_(j-1)), and its shifted G1 of order
     1 is BDF2, x2_j - x2_(j-1) = (2/3) h F_j/c + (x2_(j-1) - x2_(j-2))/3 >= 0
@@ -1007,3 +1012,73 @@ def test_repeated_impacts_converge_whatever_the_communication_step():
         value = {k: np.array([getattr(i, key) for i in v]) for k, v in runs.items()}
         change = sum(abs(value[memory, 2e-6] - value[memory, 1e-6]) for memory in (1, 2))
         assert np.all(abs(value[1, 1e-6] - value[2, 1e-6]) <= change), key
+
+
+# ------------------ 8. a general spring exponent n (with the dashpot)
+
+@pytest.mark.parametrize("n", [1.0, 2.0])
+def test_spring_exponent_against_the_gsl_reference(n):
+    """F = k x1^n with the dashpot (h20's c = 6080) against GSL's solve of
+    the same ODE (fraccontact-solve --reference --spring-exponent n, rtol
+    1e-12): SDIRK2's error C h^2 (1 + O(h/t_c)), h/t_c ~ 7e-4, so from
+    dt_max = 1e-6 to 5e-7 every figure's error falls 4x: order 2 +- 0.05
+    (measured 1.99-2.01; errors at 1e-6 from 5.7e-8, F_peak n = 1, to
+    1.2e-6, E_diss n = 2)."""
+    k = spring_k(n)
+    ref = reference("--spring-exponent", n, "--law", 2, "--k", repr(k))
+    runs = [fraccontact.impact(spring_exponent=n, k=k, law=2, dt_max=dt) for dt in (1e-6, 5e-7)]
+    for key in IMPACT_KEYS:
+        e = [getattr(r, key) / ref[key] - 1 for r in runs]
+        assert observed_order(*e) == pytest.approx(2.0, abs=0.05), (key, e)
+
+
+@pytest.mark.parametrize("n", [1.0, 2.0, 2.5])
+def test_g1_law_for_a_general_exponent_has_the_straight_line_ratio(slave, n):
+    """MODEL.md §7: x1^n = Gamma(n+1) D^-(n-1) x1, and G1 on N intervals
+    gives k x1^n Gamma(N+n)/(Gamma(N) N^n) (the straight line's sum, §4).
+    Driven at v with a rigid dashpot (c = 1e20: x1 = v t to 1e-17), N =
+    internal steps since onset (10 per communication step): the ratio is
+    1 for n = 1, 1 + 1/N for n = 2 (exact), and from mpmath at 30 digits for
+    2.5. x1 sums up to 400 steps (400 ulp), F = k x1^n carries n times that
+    and pow's ulp: 1e-13 as in test_fmu_physics."""
+    v, k = 0.5, spring_k(n)
+    s = slave(scene=2, m=0.0, v=v, c=1e20, law=1, k=k, spring_exponent=n, dt_max=1e-7)
+    for step in range(1, 41):
+        s.step(1e-6)
+        N, x1 = 10 * step, v * step * 1e-6
+        with mpmath.workdps(30):
+            ratio = float(mpmath.gamma(N + n) / (mpmath.gamma(N) * mpmath.mpf(N) ** n))
+        assert ratio == pytest.approx({1.0: 1.0, 2.0: 1 + 1 / N}.get(n, ratio), rel=4 * EPS)
+        assert s.get("F") == pytest.approx(k * x1 ** n * ratio, rel=1e-13, abs=0)
+        assert s.get("semi_integral") == pytest.approx(x1 ** n * ratio / math.gamma(n + 1), rel=1e-13, abs=0)
+
+
+@pytest.mark.parametrize("n", [1.0, 1.5, 2.0])
+def test_elastic_contact_time_of_a_power_law_spring(n):
+    """c = 1e20: the dashpot does not move (x2 ~ F t/c ~ 1e-20 m), the
+    contact is elastic: energy gives x_max = ((n+1) m v0^2/(2k))^(1/(n+1)),
+    and t_c = 2 int_0^x_max dx/v(x) = 2/(n+1) B(1/(n+1), 1/2) x_max/v0.
+    SDIRK2 on an oscillator of frequency w lags by C3 (w h)^3 a step (the
+    phase of R(i w h)) and keeps its amplitude to (gamma^4/2)(w h)^4 a step
+    (|R(i theta)| = 1 - gamma^4 theta^4/2 + ...; the theta^2 terms cancel as
+    (1 - 2 gamma)^2 = 2 gamma^2). So for n = 1 (w^2 = k/m) the contact time
+    is t_c (1 + C3 (w h)^2) and eps is exp(-gamma^4 pi (w h)^3/2), up to the
+    last, partial step's share, one step's lag in pi/(w h) steps: w h/pi =
+    6e-4 of the lag, rel 1e-3 (measured 1.2e-4 for t_c, 3.6e-5 for eps);
+    F_max = k x_max loses half of eps's 9e-11 on the way in (measured
+    4.6e-11): 1e-9.
+    For n > 1 w grows with x1 up to w_max^2 = n k x_max^(n-1)/m: the lag is
+    at most C3 (w_max h)^2 (measured 0.75 of it at n = 1.5, 0.62 at 2)."""
+    k, h = spring_k(n), 1e-6
+    r = fraccontact.impact(spring_exponent=n, k=k, law=2, c=1e20, dt_max=h)
+    x_max = ((n + 1) * M_STRIKER * V0 ** 2 / (2 * k)) ** (1 / (n + 1))
+    t_c = 2 / (n + 1) * beta_function(1 / (n + 1), 0.5) * x_max / V0
+    lag = r.t_contact / t_c - 1
+    theta_max = math.sqrt(n * k * x_max ** (n - 1) / M_STRIKER) * h
+    print(f"n {n}: t_c error {lag:.3e}, bound C3 (w_max h)^2 = {C3 * theta_max ** 2:.3e}, eps - 1 = {r.eps - 1:.2e}")
+    if n == 1.0:
+        assert lag == pytest.approx(C3 * theta_max ** 2, rel=1e-3)
+        assert r.eps - 1 == pytest.approx(math.expm1(-SDIRK ** 4 * math.pi * theta_max ** 3 / 2), rel=1e-3)
+        assert r.F_peak == pytest.approx(k * x_max, rel=1e-9)
+    else:
+        assert 0 < lag <= C3 * theta_max ** 2
