@@ -216,9 +216,12 @@ static void keep_grid_rows_until(series *out, const contact_model *cm, double in
 
 static int why_stop(const fc_params *p, const contact_model *cm)
 {
+    /* On a grid of dt_max, t_end is reached when the steps' summed times
+     * fall short of it by rounding only. */
+    const double slack = contact_steps_uniformly(cm) ? 1e-6 * p->dt_max : 0.0;
     if (cm->s.impacts >= p->impacts)
         return FC_STOP_IMPACTS;
-    if (cm->s.t >= p->t_end)
+    if (cm->s.t >= p->t_end - slack)
         return FC_STOP_T_END;
     return contact_never_returns(cm) ? FC_STOP_RECEDING : 0;
 }
@@ -239,16 +242,19 @@ static void summarize(const contact_model *cm, fc_outcome *o)
     o->k = cm->k;
 }
 
-/* The impact that has just ended, its dissipation counted from its onset. */
-static fc_impact finished_impact(const contact_state *s, double E_diss_onset)
+/* The impact that has just ended, its dissipation counted from its onset;
+ * the dent where it ended (the full G1 history ends a contact on its grid,
+ * a fraction of a step later: x2 there, less its rate over that fraction). */
+static fc_impact finished_impact(const contact_model *cm, double E_diss_onset)
 {
+    const contact_state *s = &cm->s;
     fc_impact done;
     done.t_onset = s->t_onset;
     done.v_onset = s->v_onset;
     done.F_peak = s->F_peak_contact;
     done.eps = s->eps;
     done.t_contact = s->t_contact;
-    done.x2_end = s->x2;
+    done.x2_end = s->x2 - contact_damper_rate(cm) * (s->t - (s->t_onset + s->t_contact));
     done.E_diss = s->E_diss - E_diss_onset;
     return done;
 }
@@ -297,7 +303,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         if (cm.s.in_contact && !before.in_contact)
             E_diss_onset = before.E_diss;
         if (cm.s.impacts > before.impacts) {
-            fc_impact done = finished_impact(&cm.s, E_diss_onset);
+            fc_impact done = finished_impact(&cm, E_diss_onset);
             if (cm.s.impacts == 1)
                 o->first = done;
             if (impacts && impact_list_add(impacts, &done) != 0) {

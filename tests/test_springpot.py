@@ -347,10 +347,8 @@ def test_compressed_memory_error_is_a_h2_plus_b_h_to_2_minus_alpha(alpha):
 
 # The drive stops at t1 = T/2 (the FMU's input v set to 0 there, m = 0): x is
 # held from then on, and by superposition F = k v [g(t) - g(t - t1)].
-DRIVE_STOP_XFAIL = pytest.mark.xfail(strict=True, reason=(
-    "model defect: memory = 1 (BDF2 for the striker) ignores a change of the prescribed rate v in the driven "
-    "scene with m = 0: BDF2's second value (the old v) carries on, so after v := 0 the striker drifts "
-    "(v_striker -v/3 on the next internal step, tending to -v/2) and x moves by O(v dt_max) per step"))
+# (memory 1's BDF2 restarts with one backward-Euler step when the master
+# changes v: found by these tests, its old v used to carry on.)
 
 
 def driven_slave(slave, alpha, memory, steps):
@@ -374,13 +372,13 @@ def relaxation_error(slave, alpha, memory, steps):
     return worst
 
 
-@pytest.mark.parametrize("memory", [2, pytest.param(1, marks=DRIVE_STOP_XFAIL)])
+@pytest.mark.parametrize("memory", [2, 1])
 @pytest.mark.parametrize("alpha", [0.5, 0.8])
 def test_relaxation_after_the_drive_stops_is_superposition(slave, alpha, memory):
     """The same bands as the loading above (the drive's stop is a new
     nonsmooth start for the second term); measured (memory 2) orders 1.90
     (alpha 0.5), 1.37 (0.8), errors 1.0e-6 and 2.2e-6 at T/800; memory 1
-    stays 12-13 % off (the xfail's defect)."""
+    (BDF2 restarted at the stop) 2.04 and 2.00, errors 2.2e-6 and 6.9e-6."""
     coarse, fine = relaxation_error(slave, alpha, memory, 400), relaxation_error(slave, alpha, memory, 800)
     order = observed_order(coarse, fine)
     print(f"relaxation alpha {alpha} memory {memory}: max error {coarse:.2e}, {fine:.2e}, order {order:.2f}")
@@ -388,7 +386,7 @@ def test_relaxation_after_the_drive_stops_is_superposition(slave, alpha, memory)
     assert low <= order <= high
 
 
-@pytest.mark.parametrize("memory", [2, pytest.param(1, marks=DRIVE_STOP_XFAIL)])
+@pytest.mark.parametrize("memory", [2, 1])
 def test_a_stopped_drive_holds_the_indentation(slave, memory):
     """m = 0 prescribes the rate: after v := 0 the striker stands still,
     v_striker = 0 and x = v t1 whatever the damper's memory does inside:
@@ -433,11 +431,9 @@ def test_alpha_1_compressed_memory_is_the_dashpot(slave, law):
     assert springpot.get("eps") > 0
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "model: at alpha = 1 E_diss differs from the dashpot's by 7.8e-9 relative at dt_max = 1e-7 (O(h^2): the dashpot "
-    "counts J^2/(c h) per step, the springpot the stages' F x2' by SDIRK2's weights; the springpot's is 3x closer "
-    "to the GSL reference), above the issue's 1e-9"))
 def test_alpha_1_dissipated_energy_is_the_dashpots_to_1e_9():
+    """Both count the mean force J/h times the step's travel (the springpot
+    used to weigh its stages' F x2', 7.8e-9 away): equal up to rounding."""
     springpot = fraccontact.impact(damper=2, damper_order=1.0, c_alpha=3e5, memory=2, law=2)
     dashpot = fraccontact.impact(damper=1, c=3e5, law=2)
     assert springpot.E_diss == pytest.approx(dashpot.E_diss, rel=1e-9, abs=0)
@@ -643,7 +639,11 @@ def test_compressed_memory_impact_converges_to_the_full_history(fine_impacts):
     errors = impact_orders(2, fine_impacts[1], ("F_peak", "t_contact", "E_diss"), (2.5e-7, 1.25e-7, 6.25e-8))
     for key, e in errors.items():
         for i in range(2):
-            assert 1.2 <= observed_order(e[i], e[i + 1]) <= 2.1, (key, e)
+            # E_diss counts the mean force times the travel: its error falls
+            # faster here (measured orders 2.53, 3.37, the last one near the
+            # reference's 1e-10), so only the floor is asserted for it.
+            high = math.inf if key == "E_diss" else 2.1
+            assert 1.2 <= observed_order(e[i], e[i + 1]) <= high, (key, e)
 
 
 def test_full_history_impact_converges_to_the_compressed_memory(fine_impacts):
@@ -674,15 +674,12 @@ def test_the_memories_agree_at_the_default_step():
         assert getattr(m2, key) == pytest.approx(getattr(m1, key), rel=1.04e-6, abs=0), key
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "model defect: memory = 1 reports x2_end as x2 at the first grid point after the separation, not at the "
-    "separation time it interpolates for t_contact; the dent recovers fast there, so x2_end is off by up to "
-    "dt_max |x2'| (6.8e-4 relative at dt_max = 1e-6, 1.5e-4 at 2.5e-7 in the h20 springpot), first order with "
-    "the grid's phase"))
 def test_full_history_reports_the_dent_at_the_separation(fine_impacts):
     """x2_end of memory 1 against memory 2's (which locates the separation
     and stops there): second order, so within 1e-6 at dt_max = 5e-7 (memory
-    1's other figures are within 3e-7 there)."""
+    1's other figures are within 3e-7 there). (It used to be x2 at the first
+    grid point after the separation: 6.8e-4 off at dt_max = 1e-6; now x2
+    there less its rate over the fraction of the step past the separation.)"""
     r = springpot_impact(1, 5e-7)
     assert r.x2_end == pytest.approx(fine_impacts[2].x2_end, rel=1e-6, abs=0)
 
@@ -737,11 +734,10 @@ def test_at_alpha_1_the_kernel_is_the_dashpot():
     assert len(a) == 0 and eta == 1.0
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "model defect: for alpha <= 0.03 at memory_tolerance = 1e-2 (accepted by the parameter check) soe_kernel "
-    "returns one term a = NaN, eta = NaN (the fixed-point iterations' logarithms of a negative number)"))
 @pytest.mark.parametrize("alpha", [0.01, 0.03])
 def test_the_kernel_holds_at_the_loosest_tolerance(alpha):
+    """(Found by this test: the kernel's bounds were solved by fixed-point
+    iterations whose logarithms went negative here, giving NaN terms.)"""
     error, M = kernel_error(alpha, 1e-2, 1e-7)
     assert error <= 1e-2
 
@@ -914,12 +910,12 @@ def test_bad_springpot_parameters_are_refused_by_name(slave, name, value, shown)
 
 
 def test_too_many_modes_are_refused_naming_the_tolerance(slave):
-    """A kernel of more than 160 modes (tolerance 1e-13 over a span of 1e12
-    needs about 190) is refused at initialization, naming memory_tolerance."""
-    s = slave(start=False, damper=2, memory=2, dt_max=1e-9)
+    """A kernel of more than 160 modes (tolerance 1e-12 over a span of 1e15
+    needs about 200) is refused, naming memory_tolerance."""
+    s = slave(start=False, damper=2, memory=2, dt_max=1e-12)
     s.enter()
     with pytest.raises(FMICallException):
-        s.set(memory_tolerance=1e-13)
+        s.set(memory_tolerance=1e-12)
         s.fmu.exitInitializationMode()
     assert "memory_tolerance" in s.last_error() and "160" in s.last_error(), s.last_error()
 
@@ -998,10 +994,9 @@ def test_repeated_impacts_under_gravity_agree_between_the_memories(slave):
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "model limitation: memory 2 steps a recovering dent at 1/8 of the time since separation (RECOVERY_STEP_FRACTION), "
-    "whatever dt_max, when no communication step bounds it: the second impact's eps is 4.7e-6 relative off the "
-    "converged value (library: 0.83232881; FMU with H = 1e-6: 0.83233271; H = 1e-3: 0.83232973) and does not "
-    "fall with dt_max"))
+    "model limitation: memory 2 steps a recovering dent at 1/16 of the time since separation "
+    "(RECOVERY_STEP_FRACTION), whatever dt_max, when no communication step bounds it, so the second impact's eps "
+    "does not fall with dt_max (4.7e-6 relative off at 1/8; the error-controlled steps of issue 14 lift this)"))
 def test_repeated_impacts_converge_whatever_the_communication_step():
     """The library's run (no communication steps): memory 2 against memory
     1, at dt_max 2e-6 and 1e-6, by the same bound as above, on the impacts'

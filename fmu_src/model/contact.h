@@ -87,8 +87,8 @@ typedef struct {
     double t_contact; /* duration of the last finished impact [s] */
     int64_t n;        /* internal steps since the onset of the current contact */
     int64_t steps;    /* internal steps taken */
-    double x_prev;    /* central differences: total indentation one step back, */
-    double h_prev;    /* and that step (0: not yet known) */
+    double x_prev;    /* central differences and the full G1 history's BDF2: */
+    double h_prev;    /* total indentation one step back, and that step (0: restart) */
     int64_t impacts;  /* finished impacts */
     int in_contact;
     /* Not part of the state carried from step to step (so not listed
