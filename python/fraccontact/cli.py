@@ -11,7 +11,8 @@ from . import reports
 
 COMMANDS = {
     "run": "the paper's h20 drop test through the FMU: figures, docs/h20_drop.csv and .png (report h20_drop)",
-    "fit": "k, c and E_s from a drop test's F_peak and eps, or from a measured force curve",
+    "fit": "k and a dashpot (c) or springpot (c_alpha, alpha), and E_s, from drop tests (F_peak and eps, a table "
+           "of heights) or measured force curves",
     "sweep": "parameter sweeps and Monte Carlo campaigns on Dask, a library call per task",
     "cosim": "the drop test as two FMUs (striker + contact) coupled through fmpy or libcosim",
     "report": "regenerate a report under docs/: fraccontact report NAME [OPTIONS...]",
