@@ -463,15 +463,16 @@ def convergence(program, name, case, law):
 # A springpot case runs the compressed memory (memory = 2) at the case's
 # dt_max and the full G1 history (memory = 1) at the same step or, where
 # that would take more than SP_MEMORY1_STEPS steps (its cost is O(N^2):
-# 0.85 ns per history term here, 0.35 s at 2e4 steps, 8.5 s at 1e5, 14 min
-# at 1e6), at the coarser uniform step that takes that many. Both use the
+# 0.92 ns per history term here, N^2/2 terms: 1.2 s at 5e4 steps, 4.6 s at
+# 1e5, 8.5 min at its limit of 1048576), at the coarser uniform step that
+# takes that many. Both use the
 # closed-form spring k x1^n (law = hertz): its energy is a potential, so
 # the energy identity holds exactly in the model, and the G1 spring law's
 # own first-order error (checked by the dashpot matrix above) stays out of
 # the springpot's figures.
 
 SP_OMEGA = 2400.0  # [rad/s] the h20 impact's frequency pi/t_c (MODEL.md §7)
-SP_MEMORY1_STEPS = 20000
+SP_MEMORY1_STEPS = 50000
 SP_X_REF = hertz.indentation(H20["k"], H20["m"], H20["v"])  # the h20 Hertz impact's x_max
 SP_BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g=0.0, gap0=0.0, impacts=1,
                t_end=0.0, tolerance=H20["memory_tolerance"], memory1_steps=SP_MEMORY1_STEPS)
@@ -954,8 +955,8 @@ SP_FINDINGS = {
         "the step's secant, has the same cause: between dt = t_c/640 and t_c/2560 its error over h^2 reaches "
         "395 at alpha = 0.05 (order 0.7) and 35 at n = 1 (order 0.6), against 1.3 to 5 where alpha >= 0.5; "
         "the matrix does not compare it. A limitation of the uniform grid at small alpha; extrapolating x1 "
-        "and x2 from the contact side would keep the state's order. The compressed memory locates the separation within its step and "
-        "is not affected.",
+        "and x2 from the contact side would keep the state's order. The compressed memory locates the "
+        "separation within its step and is not affected.",
     SP_RECOVERY:
         "Out of contact, while the dent recovers, the compressed memory takes SDIRK2 steps of a fixed fraction "
         "of the time since the separation (RECOVERY_STEP_FRACTION in fmu_src/model/contact.c, 1/64 since "
@@ -1040,9 +1041,10 @@ def sp_report(study, rows, elapsed):
            "dashpot matrix's): the compressed memory (memory = 2) at the case's dt_max, every internal step's "
            "row kept (under gravity also the recovering flights, sampled 4000 times), and the full G1 history "
            f"(memory = 1) at the same step (or just below: a whole number of steps to the end) or, where that "
-           f"would take more than {SP_MEMORY1_STEPS:.0e} steps, at the uniform step that takes that many. Memory 1 costs O(N^2): 0.85 ns per history term here, 0.35 s "
-           "at 2e4 steps, 8.5 s at 1e5, some 14 min at its limit of 1048576; 2e4 keeps the test fast, and the "
-           "memories are compared each at its own step (the tolerance adds both errors).", "",
+           f"would take more than {SP_MEMORY1_STEPS:,} steps, at the uniform step that takes that many. Memory 1 "
+           "costs O(N^2), 0.92 ns per history term here (N^2/2 of them): 1.2 s at 5e4 steps, 4.6 s at 1e5, some "
+           "8.5 min at its limit of 1,048,576; 5e4 keeps the test to some 20 s, and the memories are compared "
+           "each at its own step (the tolerance adds both errors).", "",
            "## Checks (springpot)", "",
            "At every row, with no allowance beyond rounding (4 ulp per step, as above):", "",
            "- **finite**: every output and row finite, the run completed;",
