@@ -976,9 +976,9 @@ SP_FINDINGS = {
         "second condition that the indentation falls (x1' <= 0), and its x1 comes from x = x1 + x2 through "
         "BDF2's (4x_n - x_(n-1))/3, so it carries the rounding of x. A striker sinking into a soft damper "
         "creeps on with x1 decaying towards 0 without ever separating (memory 2: no impact to t = 0.5 s, "
-        "v = 1.7e-36 m/s at 1 s); memory 1's x1 is quantized in steps of ulp(x)/3 = 2.9e-19 m, reaches 0 at "
+        "v = 1.1e-18 m/s there); memory 1's x1 is quantized in steps of ulp(x)/3 = 2.9e-19 m, reaches 0 at "
         "t = 0.370 s while the striker still moves in at 6.4e-14 m/s, and reports an impact with "
-        "eps = -1.0e-13 (n = 1, k = 2.57e6 N/m, alpha = 1, c_alpha = 60.8, dt_max = 5e-5; within eps's rounding "
+        "eps = -1.0e-13 (n = 1, k = 5.33e6 N/m, alpha = 1, c_alpha = 60.8, dt_max = 5e-5; within eps's rounding "
         "allowance, so it is the comparison of the memories that catches it). Reported to the "
         "model's owners: require x1' <= 0 at a G1-history separation as the SDIRK path does.",
 }
