@@ -425,13 +425,13 @@ typedef struct {
  * F = K max(x1, 0)^n, x2' = (F - A) inv_B:
  *     X = xh + hg (V - x2'),  V = vh + hg (accel - inv_m F).
  * Eliminating V and x2' leaves X + beta X^n = r, one scalar root. Returns F. */
-static double implicit_stage(const contact_model *cm, double K, double hg, double xh, double vh,
-                             const damper_stage *d, double *X, double *V)
+static inline double implicit_stage(const contact_model *cm, double K, double hg, double xh, double vh,
+                                    damper_stage d, double *X, double *V)
 {
-    double r = xh + hg * (vh + hg * cm->accel) + hg * d->A * d->inv_B;
+    double r = xh + hg * (vh + hg * cm->accel) + hg * d.A * d.inv_B;
     double F = 0.0;
     if (r > 0.0 && K > 0.0)
-        F = stage_force(cm, K, r, K * hg * (d->inv_B + hg * cm->inv_m), X);
+        F = stage_force(cm, K, r, K * hg * (d.inv_B + hg * cm->inv_m), X);
     else
         *X = r; /* out of contact the striker moves freely */
     *V = vh + hg * (cm->accel - cm->inv_m * F);
@@ -523,20 +523,23 @@ static int memory_at_rest(const contact_model *cm)
 /* One SDIRK step of length h from *in with spring stiffness K (0: no
  * contact: free flight, exact while the damper rests). Writes t, x1, x2, v,
  * F, E_diss and what accepting the step needs (its length and the damper's
- * stage rates) of *out; returns the impulse of the contact force. */
-static double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+ * stage rates) of *out; returns the impulse of the contact force. Inlined
+ * twice below, so that the dashpot's copy carries none of the springpot's
+ * work: `springpot` and `compressed` are constants in each. */
+static inline double sdirk_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
+                                   const int springpot, const int compressed)
 {
     const double hg = SDIRK_GAMMA * h, hb = (1.0 - SDIRK_GAMMA) * h;
     damper_stage d1 = {0.0, cm->inv_c}, d2 = {0.0, cm->inv_c};
     double X1, V1, X2, V2, F1, F2, z1, z2, impulse, Sq = 0.0;
 
-    if (compressed_memory(cm))
+    if (compressed)
         springpot_stages(cm, h, &d1, &Sq);
-    F1 = implicit_stage(cm, K, hg, in->x1, in->v, &d1, &X1, &V1);
+    F1 = implicit_stage(cm, K, hg, in->x1, in->v, d1, &X1, &V1);
     z1 = (F1 - d1.A) * d1.inv_B;
-    if (compressed_memory(cm))
+    if (compressed)
         springpot_second_stage(cm, h, &d1, Sq, z1, &d2);
-    F2 = implicit_stage(cm, K, hg, in->x1 + hb * (V1 - z1), in->v + hb * (cm->accel - cm->inv_m * F1), &d2, &X2,
+    F2 = implicit_stage(cm, K, hg, in->x1 + hb * (V1 - z1), in->v + hb * (cm->accel - cm->inv_m * F1), d2, &X2,
                         &V2);
     z2 = (F2 - d2.A) * d2.inv_B;
     impulse = hb * F1 + hg * F2;
@@ -549,7 +552,7 @@ static double sdirk_step(contact_model *cm, const contact_state *in, double h, d
     out->step = h;
     out->x2_rate1 = z1;
     out->x2_rate = z2;
-    if (springpot(cm)) {
+    if (springpot) {
         /* The mean force J/h times the travel, as the dashpot below counts
          * (within O(h^3) of the integral of F x2'; at alpha = 1 the same). */
         out->x2 = in->x2 + hb * z1 + hg * z2;
@@ -564,6 +567,13 @@ static double sdirk_step(contact_model *cm, const contact_state *in, double h, d
     out->x2 = in->x2 + impulse * cm->inv_c;
     out->E_diss = in->E_diss + (h > 0.0 ? impulse * impulse * cm->inv_c / h : 0.0);
     return impulse;
+}
+
+static double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    if (!springpot(cm))
+        return sdirk_step_of(cm, in, h, K, out, 0, 0);
+    return sdirk_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }
 
 /* Makes a trial step the model's state, and its memory follow. */
@@ -885,7 +895,7 @@ static int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
     v_h = bdf2 ? (4.0 * s->v - hist->v_prev) / 3.0 : s->v;
     d.inv_B = mu / hg;
     d.A = -nu / mu;
-    F = implicit_stage(cm, contact_spring_stiffness(cm, s->in_contact ? s->n + 1 : 1), hg, x_h, v_h, &d, &X, &V);
+    F = implicit_stage(cm, contact_spring_stiffness(cm, s->in_contact ? s->n + 1 : 1), hg, x_h, v_h, d, &X, &V);
     s->x_prev = x;
     hist->v_prev = s->v;
     s->t += h;
