@@ -21,12 +21,14 @@
 #define MAX_EVENTS_PER_STEP 1000
 
 /* While a springpot's dent recovers in free flight, its memory relaxes on
- * the time scale of the time since separation: steps of this fraction of
- * it (at least dt_max), O(log) many however long the flight (about 800
- * from an h20 separation to the next impact under gravity, 0.1 s later).
- * SDIRK2's error in the recovery is second order in the fraction: the
- * second impact's eps was off by 4.7e-6 at 1/8 and 1.2e-6 at 1/16. */
-#define RECOVERY_STEP_FRACTION (1.0 / 64.0)
+ * the time scale of the time since separation: steps of a fraction f of it
+ * (at least dt_max), O(log) many however long the flight. SDIRK2's error in
+ * the recovery is O(f^2) (the second impact's eps was off by 4.7e-6 at
+ * f = 1/8, 1.2e-6 at 1/16), so f shrinks with dt_max, f = RECOVERY_STEPS
+ * dt_max / t_contact (at most 1/16), for an error of O(dt_max^2) like the
+ * contact's: the flight to the next impact then takes about a sixth of the
+ * last contact's steps. */
+#define RECOVERY_STEPS 64.0
 
 void contact_default_params(contact_params *p)
 {
@@ -846,7 +848,9 @@ static int g1_contact_events(contact_model *cm, const contact_state *before, uns
         begin_contact(s, t, v);
     if (s->F > 0.0)
         count_contact_step(s, s->F);
-    if (before->in_contact && !(s->F > 0.0))
+    /* as the SDIRK path: a contact ends with the indentation falling, not
+     * while the striker still moves in and x1 rounds to 0 */
+    if (before->in_contact && s->in_contact && !(s->F > 0.0) && !(s->v - s->x2_rate > 0.0))
         end_contact(s, t, v);
     if (s->in_contact == before->in_contact && s->impacts == before->impacts)
         return 0;
@@ -1014,8 +1018,10 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
 /* The next step out of contact while a springpot's memory relaxes. */
 static double recovery_step(const contact_model *cm, double remaining)
 {
-    const double since = cm->s.impacts > 0 ? cm->s.t - (cm->s.t_onset + cm->s.t_contact) : 0.0;
-    return fmin(remaining, fmax(cm->p.dt_max, RECOVERY_STEP_FRACTION * since));
+    const contact_state *s = &cm->s;
+    const double since = s->impacts > 0 ? s->t - (s->t_onset + s->t_contact) : 0.0;
+    const double f = s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->p.dt_max / s->t_contact) : 1.0 / 16.0;
+    return fmin(remaining, fmax(cm->p.dt_max, f * since));
 }
 
 double contact_advance(contact_model *cm, double H)

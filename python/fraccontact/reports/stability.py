@@ -940,8 +940,6 @@ def sp_convergence(name, case):
 # --- The springpot's findings: what fails, and why (docs/stability.md).
 
 SP_T_CONTACT = "memory 1: t_contact across the separation's step"
-SP_RECOVERY = "memory 2: the dent's recovery in free flight"
-SP_ROUNDING = "memory 1: a separation made by rounding"
 SP_FINDINGS = {
     SP_T_CONTACT:
         "The full G1 history steps on a uniform grid and does not split a step at the separation: it "
@@ -957,30 +955,6 @@ SP_FINDINGS = {
         "the matrix does not compare it. A limitation of the uniform grid at small alpha; extrapolating x1 "
         "and x2 from the contact side would keep the state's order. The compressed memory locates the "
         "separation within its step and is not affected.",
-    SP_RECOVERY:
-        "Out of contact, while the dent recovers, the compressed memory takes SDIRK2 steps of a fixed fraction "
-        "of the time since the separation (RECOVERY_STEP_FRACTION in fmu_src/model/contact.c, 1/64 since "
-        "66102e3, 1/8 before), whatever dt_max and memory_tolerance: its error in the recovering dent is a "
-        "fixed fraction of it that no parameter of the library or the solver lowers. h20 springpot (alpha 0.5, "
-        "law hertz) under gravity, x2 at t = 20 ms (18.6 ms after the separation): memory 2 gives "
-        "1.1297912e-5 m at dt_max = 1e-6, 1e-7 and 1e-8 alike (to 4e-8 relative), memory 1 converges to "
-        "1.1297975e-5 m (dt 2e-6, 1e-6, 5e-7: 1.1297994, 1.1297980, 1.1297977e-5, extrapolated): memory 2 "
-        "is 5.6e-6 low (2.9e-4 at 1/8). Through the FMU, whose communication steps bound the recovery steps, "
-        "memory 2 converges (H = 1e-3, 1e-4, 1e-5, 1e-6: 1.1297915, 1.1297956, 1.12979727, 1.12979729e-5) to "
-        "2.2e-7 of memory 1's value, within the kernel's tolerance. The impacts that follow are hardly "
-        "affected (the owners' test: the second eps 1.2e-7 off memory 1's extrapolation), but the dent "
-        "itself, item 8's recovery plot, stays 5.6e-6 off in the library and the solver. Reported to the "
-        "model's owners: a fraction tied to the tolerance (the step count grows only as its log).",
-    SP_ROUNDING:
-        "The full G1 history ends a contact when the force is no longer positive, without the SDIRK path's "
-        "second condition that the indentation falls (x1' <= 0), and its x1 comes from x = x1 + x2 through "
-        "BDF2's (4x_n - x_(n-1))/3, so it carries the rounding of x. A striker sinking into a soft damper "
-        "creeps on with x1 decaying towards 0 without ever separating (memory 2: no impact to t = 0.5 s, "
-        "v = 1.1e-18 m/s there); memory 1's x1 is quantized in steps of ulp(x)/3 = 2.9e-19 m, reaches 0 at "
-        "t = 0.370 s while the striker still moves in at 6.4e-14 m/s, and reports an impact with "
-        "eps = -1.0e-13 (n = 1, k = 5.33e6 N/m, alpha = 1, c_alpha = 60.8, dt_max = 5e-5; within eps's rounding "
-        "allowance, so it is the comparison of the memories that catches it). Reported to the "
-        "model's owners: require x1' <= 0 at a G1-history separation as the SDIRK path does.",
 }
 # Non-failing: the compressed memory's order (built into SP_K2's form).
 SP_ORDER_FINDING = (
@@ -1002,8 +976,9 @@ SP_KNOWN = {("alpha 0.05, c_alpha x 0.01", 1): {SP_AGREE: SP_T_CONTACT},
             ("n 1, alpha 0.05", 1): {SP_AGREE: SP_T_CONTACT}}
 # Defects reported to the model's owners: expected to fail until fixed, like
 # a known finding (a fix makes the script fail: remove the entry).
-SP_DEFECTS = {("gravity, the dent recovering in flight to 20 ms", 1): {SP_AGREE: SP_RECOVERY},
-              ("n 1, alpha 1, c_alpha x 0.01: creeping in to 0.5 s", 1): {SP_AGREE: SP_ROUNDING}}
+# (The first run's two, the dent's recovery in flight fixed to a fraction of
+# the time since separation and memory 1 separating by rounding, are fixed.)
+SP_DEFECTS = {}
 SP_FAST = {"alpha 0.05", "alpha 0.95", "alpha 1", "alpha 0.05, c_alpha x 1e-06", "alpha 0.05, c_alpha x 1e+06",
            "alpha 0.95, c_alpha x 1e-06", "alpha 0.95, c_alpha x 1e+06", "alpha 1, c_alpha x 1e-06",
            "n 1, alpha 0.05", "n 2, alpha 0.95", "n 1, alpha 0.95, c_alpha x 0.0001",
@@ -1123,7 +1098,8 @@ def sp_report(study, rows, elapsed):
                 f"cases ({unresolved} where memory 1's step does not resolve t_c; in {fast_only} of them memory 1's "
                 "step does not resolve the force's rise t_F, so F_peak, E_diss and E_end are left out).", "",
             "## Findings (springpot)", "", "- " + SP_ORDER_FINDING]
-    out += [f"- **{k}** ({'defect, reported' if k in (SP_RECOVERY, SP_ROUNDING) else 'known finding'}): {v}"
+    reported = {finding for checks in SP_DEFECTS.values() for finding in checks.values()}
+    out += [f"- **{k}** ({'defect, reported' if k in reported else 'known finding'}): {v}"
             for k, v in SP_FINDINGS.items()]
     out.append("")
     failed = [(n, r) for n, c, r in rows if r["failures"]]
