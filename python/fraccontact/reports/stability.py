@@ -988,6 +988,15 @@ SP_FAST = {"alpha 0.05", "alpha 0.95", "alpha 1", "alpha 0.05, c_alpha x 1e-06",
            "at rest, gravity: creep, alpha 0.1, 1e6 steps", "m 1000"}
 
 
+def check_table(rows, checks):
+    """The summary's table: for each check, the runs it applied to, passed and failed."""
+    lines = ["| check | runs checked | pass | fail |", "|---|---|---|---|"]
+    for c in checks:
+        checked = [o for o in (r["checks"].get(c) for *_, r in rows) if o is not None]
+        lines.append(f"| {c} | {len(checked)} | {sum(1 for o in checked if not o)} | {sum(1 for o in checked if o)} |")
+    return lines
+
+
 def sp_expected(name, memory):
     """{check: finding} listed for the run: its known findings and defects."""
     return {**SP_KNOWN.get((name, memory), {}), **SP_DEFECTS.get((name, memory), {})}
@@ -1086,11 +1095,7 @@ def sp_report(study, rows, elapsed):
     out += ["## Summary (springpot)", "",
             f"**{passed} of {n_runs} runs pass every check; {n_known} fail one as a known finding, {n_defect} as a "
             f"defect reported to the model's owners (below); {n_bad} fail otherwise.**", "",
-            "| check | runs checked | pass | fail |", "|---|---|---|---|"]
-    for c in SP_CHECKS:
-        outcomes = [r["checks"].get(c) for *_, r in rows]
-        checked = [o for o in outcomes if o is not None]
-        out.append(f"| {c} | {len(checked)} | {sum(1 for o in checked if not o)} | {sum(1 for o in checked if o)} |")
+            *check_table(rows, SP_CHECKS)]
     unresolved = sum(1 for *_, r in rows if r["memory"] == 1 and r["checks"].get(SP_AGREE) is None)
     fast_only = sum(1 for *_, r in rows if r["memory"] == 1 and r.get("h_F", 0) > 1.0 / RESOLVED
                     and r["checks"].get(SP_AGREE) is not None)
@@ -1253,11 +1258,7 @@ def write_report(path, study, rows, elapsed, springpot=()):
     out += ["", "## Summary", "",
             f"**{passed} of {n_runs} runs pass every check; {n_known} fail one as a known finding of the time "
             f"scheme (below); {n_bad} fail otherwise.**", "",
-            "| check | runs checked | pass | fail |", "|---|---|---|---|"]
-    for c in CHECKS:
-        outcomes = [r["checks"].get(c) for *_, r in rows]
-        checked = [o for o in outcomes if o is not None]
-        out.append(f"| {c} | {len(checked)} | {sum(1 for o in checked if not o)} | {sum(1 for o in checked if o)} |")
+            *check_table(rows, CHECKS)]
     out += ["", f"A run is compared with the reference when at least one of its figures is resolved; "
                 f"{sum(1 for *_, r in rows if r['checks'].get('reference') is None)} runs resolve none "
                 "(steps near or beyond the contact time, or a stiff dashpot's force rise): for them the "
