@@ -214,11 +214,11 @@ static void keep_grid_rows_until(series *out, const contact_model *cm, double in
     *k = (int64_t)floor(cm->s.t / interval) + 1;
 }
 
-static int why_stop(const fc_params *p, const contact_model *cm)
+/* Why the run stops here, if it does; `slack`: how far short of t_end the
+ * run may stop (on a grid of dt_max, the steps' summed times fall short of
+ * it by rounding). */
+static int why_stop(const fc_params *p, const contact_model *cm, double slack)
 {
-    /* On a grid of dt_max, t_end is reached when the steps' summed times
-     * fall short of it by rounding only. */
-    const double slack = contact_steps_uniformly(cm) ? 1e-6 * p->dt_max : 0.0;
     if (cm->s.impacts >= p->impacts)
         return FC_STOP_IMPACTS;
     if (cm->s.t >= p->t_end - slack)
@@ -276,24 +276,27 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     contact_model cm, snapshot;
     double E_diss_onset = 0.0;
     int64_t k = 1, reported = 0;
+    int uniform, grid;
     memset(o, 0, sizeof *o);
     if (fc_params_check(p, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
+    uniform = contact_steps_uniformly(&cm);
+    grid = rows_on_grid(&q);
     if (out)
         keep(out, &cm);
-    while (!(o->stop = why_stop(p, &cm))) {
+    while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * q.dt_max : 0.0))) {
         const contact_state before = cm.s;
         double H = p->t_end - cm.s.t;
         int rows_inside;
-        if (rows_on_grid(&q))
+        if (grid) {
             H = q.dt_max;
-        else if (cm.s.in_contact || contact_steps_uniformly(&cm))
+            if (contact_check_advance(&cm, H, msg, len) != 0)
+                return finish(&cm, o, FC_EFAIL);
+        } else if (cm.s.in_contact || uniform)
             H = fmin(H, q.dt_max);
-        if (contact_check_advance(&cm, H, msg, len) != 0)
-            return finish(&cm, o, FC_EFAIL);
-        rows_inside = out && interval > 0.0 && !rows_on_grid(&q) && (double)k * interval <= cm.s.t + H;
+        rows_inside = out && interval > 0.0 && !grid && (double)k * interval <= cm.s.t + H;
         if (rows_inside)
             snapshot = cm; /* no G1 history in it: a plain copy */
         if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
@@ -312,7 +315,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             }
         }
         if (out) {
-            if (rows_on_grid(&q))
+            if (grid)
                 keep_grid_rows_until(out, &cm, interval, &k);
             else if (rows_inside)
                 keep_rows_until(out, &snapshot, cm.s.t, interval, &k);

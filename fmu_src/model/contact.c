@@ -403,17 +403,23 @@ static double power_root(double r, double beta, double n)
 }
 
 /* The elastic indentation X of an implicit stage, X + beta X^n = r, and the
- * spring force K X^n there. */
-static double stage_force(const contact_model *cm, double K, double r, double beta, double *X)
+ * spring force K X^n there: the Hertz sphere's n = 1.5 inline (the common
+ * case, on every step), any other n apart. */
+static double other_stage_force(const contact_model *cm, double K, double r, double beta, double *X)
 {
     const double n = cm->p.spring_exponent;
-    if (n == 1.5) {
-        double s = stage_root(r, beta);
-        *X = s * s;
-        return K * s * s * s;
-    }
     *X = n == 1.0 ? r / (1.0 + beta) : power_root(r, beta, n);
     return spring_force(cm, K, *X);
+}
+
+static inline double stage_force(const contact_model *cm, double K, double r, double beta, double *X)
+{
+    double s;
+    if (cm->p.spring_exponent != 1.5)
+        return other_stage_force(cm, K, r, beta, X);
+    s = stage_root(r, beta);
+    *X = s * s;
+    return K * s * s * s;
 }
 
 /* What the damper makes of an implicit stage: its rate x2' = (F - A) inv_B,
@@ -579,7 +585,7 @@ static double sdirk_step(contact_model *cm, const contact_state *in, double h, d
 }
 
 /* Makes a trial step the model's state, and its memory follow. */
-static void accept_step(contact_model *cm, const contact_state *trial)
+static inline void accept_step(contact_model *cm, const contact_state *trial)
 {
     if (compressed_memory(cm))
         advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
