@@ -899,9 +899,7 @@ def section_memory(k, agree, lad):
                   + "; ".join(f"tolerance {e(b['tol'], 0)}: alpha {b['lo']:g} ... {b['hi']:g} ({b['count']} values)"
                               for b in k["broken"])
                   + f". `fraccontact.impact(damper=2, damper_order={k['broken'][0]['lo']:g}, memory_tolerance="
-                  f"{e(k['broken'][0]['tol'], 0)})` says: \"{k['broken'][0]['failure']}\". (soe.c's fixed point for "
-                  "the trapezoidal step, aliasing_frequency, takes the log of a number below 1 when Gamma(alpha) "
-                  "is large; the default tolerance 1e-6 is not affected.)"]
+                  f"{e(k['broken'][0]['tol'], 0)})` says: \"{k['broken'][0]['failure']}\"."]
     lines += ["", "Against the published counts for tau^(-1/2) (MODEL.md §8, Jiang et al. 2017), the same alpha = 0.5 "
               "kernel with dt_max = delta/T x 1000 s:", "",
               "| tolerance | delta/T | published M | M here | kernel error here |", "|---|---|---|---|---|"]
