@@ -15,7 +15,11 @@ struct fmu_model {
     double v, m;          /* the inputs as last set */
     double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
     double F_avg;         /* impulse of the last communication step / its length */
+    double step_span;     /* that length: where an early return cut it, so far */
     int started;          /* past initialization: fixed parameters are frozen */
+    int held;             /* a step stopped at an event: the discrete outputs show */
+    int held_contact;     /* their values from before it until fm_update_discrete */
+    double held_eps;
     contact_model model;
     fmu_reporter log;
 };
@@ -152,7 +156,7 @@ static double real_output(const fmu_model *fm, unsigned vr)
     case VR_x2: return cm->s.x2;
     case VR_v_striker: return cm->s.v;
     case VR_E_diss: return cm->s.E_diss;
-    case VR_eps: return cm->s.eps;
+    case VR_eps: return fm->held ? fm->held_eps : cm->s.eps;
     case VR_semi_integral: return contact_semi_integral(cm);
     default: return 0.0;
     }
@@ -206,7 +210,7 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
     if (!fmu_find(&variables, vr, VAR_BOOLEAN, &fm->log))
         return FM_ERROR;
     preview_start(fm);
-    *value = fm->model.s.in_contact;
+    *value = fm->held ? fm->held_contact : fm->model.s.in_contact;
     return FM_OK;
 }
 
@@ -220,13 +224,13 @@ static fm_status order_one(fmu_model *fm, const char *what, unsigned vr, int ord
 
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
 {
-    if (order_one(fm, "fmi2SetRealInputDerivatives", vr, order) != FM_OK)
+    if (order_one(fm, "SetRealInputDerivatives", vr, order) != FM_OK)
         return FM_ERROR;
     if (vr != VR_v)
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2SetRealInputDerivatives: value reference %u: only v (%d) takes a derivative", vr, VR_v);
+                      "SetRealInputDerivatives: value reference %u: only v (%d) takes a derivative", vr, VR_v);
     if (!isfinite(value))
-        return report(fm, FM_ERROR, "logStatusError", "fmi2SetRealInputDerivatives: dv/dt = %g must be finite",
+        return report(fm, FM_ERROR, "logStatusError", "SetRealInputDerivatives: dv/dt = %g must be finite",
                       value);
     fm->v_slope = value;
     return FM_OK;
@@ -236,7 +240,7 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
 {
     const contact_model *cm = &fm->model;
     double x1_rate, v_rate, F_rate;
-    if (order_one(fm, "fmi2GetRealOutputDerivatives", vr, order) != FM_OK)
+    if (order_one(fm, "GetOutputDerivatives", vr, order) != FM_OK)
         return FM_ERROR;
     contact_rates(cm, &x1_rate, &v_rate, &F_rate);
     switch (vr) {
@@ -249,14 +253,14 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     case VR_semi_integral: *value = F_rate * contact_semi_integral_per_force(cm); break;
     default:
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2GetRealOutputDerivatives: value reference %u has no time derivative here "
+                      "GetOutputDerivatives: value reference %u has no time derivative here "
                       "(F, x, x1, x2, v_striker, E_diss, semi_integral have)", vr);
     }
     /* Extreme but valid states (k near DBL_MAX, say) can overflow a rate
      * that the state itself does not. */
     if (!isfinite(*value))
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2GetRealOutputDerivatives: the time derivative of value reference %u overflows (%g)", vr,
+                      "GetOutputDerivatives: the time derivative of value reference %u overflows (%g)", vr,
                       *value);
     return FM_OK;
 }
@@ -271,6 +275,8 @@ fm_status fm_start(fmu_model *fm, double t0)
     contact_start(&fm->model, &fm->params, fm->v, fm->m);
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
+    fm->step_span = 0.0;
+    fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
@@ -311,42 +317,76 @@ static void report_events(fmu_model *fm, const contact_state *before)
                before->t, s->t, s->v_onset);
 }
 
+void fm_update_discrete(fmu_model *fm)
+{
+    fm->held = 0;
+}
+
+/* Whether the contact began or an impact ended since `before`. */
+static int event_since(const contact_state *before, const contact_state *now)
+{
+    return now->in_contact != before->in_contact || now->impacts != before->impacts;
+}
+
 fm_status fm_do_step(fmu_model *fm, double t, double H)
+{
+    int event;
+    return fm_do_step_until(fm, t, H, 0u, &event);
+}
+
+fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
 {
     contact_model *cm = &fm->model;
     contact_state before;
     memory_copy memory;
     char why[512];
-    double impulse, F_avg = fm->F_avg;
+    double impulse, span, F_avg = fm->F_avg, step_span = fm->step_span;
     const fmu_variable *overflow;
+    const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
+    *event = 0;
+    fm_update_discrete(fm); /* a new step: the master has seen the last event */
     /* About a minute of CPU: beyond that a step is a mistake, not a wish. */
     if (H / fm->params.dt_max > 1e9)
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
+                      "DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
                       "of dt_max = %g; take shorter communication steps or a larger dt_max", H, fm->params.dt_max);
     cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
     if (H == 0.0)
         return FM_OK;
     if (contact_check_advance(cm, H, why, sizeof why) != 0)
-        return report(fm, FM_ERROR, "logStatusError", "fmi2DoStep: communicationStepSize = %.17g: %s", H, why);
+        return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
     contact_drive(cm, fm->v, fm->m, fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
-    impulse = contact_advance(cm, H);
+    impulse = contact_advance_until(cm, H, stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u);
     if (isnan(impulse))
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2DoStep: the state became non-finite in [%.17g, %.17g] s; "
+                      "DoStep: the state became non-finite in [%.17g, %.17g] s; "
                       "it is kept at the start of the step", t, t + H);
-    fm->F_avg = impulse / H;
+    *event = stop && event_since(&before, &cm->s);
+    span = *event ? cm->s.t - t : H;
+    if (resume) { /* the average over the whole communication step so far */
+        impulse += F_avg * step_span;
+        span += step_span;
+    }
+    fm->F_avg = span > 0.0 ? impulse / span : cm->s.F;
+    fm->step_span = span;
     overflow = nonfinite_output(fm);
     if (overflow) {
         double value = real_output(fm, overflow->vr);
         cm->s = before;
         restore_memory(cm, &memory);
         fm->F_avg = F_avg;
+        fm->step_span = step_span;
+        *event = 0;
         return report(fm, FM_ERROR, "logStatusError",
-                      "fmi2DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
+                      "DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
                       "the state is kept at the start of the step", overflow->name, value, t, t + H);
+    }
+    if (*event) {
+        fm->held = 1;
+        fm->held_contact = before.in_contact;
+        fm->held_eps = before.eps;
     }
     report_events(fm, &before);
     return FM_OK;
@@ -367,7 +407,8 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
-    I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), I(started),
+    I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), F(step_span),
+    I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values
@@ -441,6 +482,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
+        || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
     for (i = 0; i < count; i++)

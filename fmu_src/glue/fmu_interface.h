@@ -1,4 +1,4 @@
-/* What the FMI glue (fmi2_cosim.c) asks of a model: the hook interface each
+/* What the FMI glue (fmi2_cosim.c, fmi3_cosim.c) asks of a model: the hook interface each
  * FMU's binding implements (fmu_src/binding/fmu_model.c for the contact
  * element, striker/striker_model.c for the striker). No FMI types: plain C
  * values and statuses numerically equal to the FMI ones. */
@@ -43,6 +43,18 @@ fm_status fm_start(fmu_model *fm, double t0);
  * the master's rounding: the model takes t as its time. */
 fm_status fm_do_step(fmu_model *fm, double t, double H);
 double fm_time(const fmu_model *fm);
+
+/* For FMI 3.0's early return and event mode (a model served by the FMI 2.0
+ * glue alone need not define these). fm_do_step with options:
+ * FM_STOP_AT_EVENT ends the step right after the model's first event inside
+ * it (*event = 1, and fm_time tells when); FM_CONTINUE continues the
+ * communication step that the last call ended at an event, so that averages
+ * over the step cover both parts. After a stop at an event the discrete
+ * outputs keep their values from before it until fm_update_discrete (FMI
+ * 3.0's event mode) or the next step. */
+enum { FM_STOP_AT_EVENT = 1, FM_CONTINUE = 2 };
+fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event);
+void fm_update_discrete(fmu_model *fm);
 
 /* The model's part of the FMU state, as fm_state_size(fm) bytes in the
  * platform-independent layout of serial.h (a model with a growing memory
