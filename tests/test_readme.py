@@ -220,3 +220,22 @@ def test_k_wins_over_the_materials_as_the_table_says():
     assert derived != reference and derived == pytest.approx(reference, rel=2e-3, abs=0)
     assert drop_peak(k=0.0, E_s=1.2e9) < 0.9 * reference
     assert math.isfinite(derived)
+
+
+# --- issue 13: the FMI 3.0 example --------------------------------------------
+
+def test_the_readme_fmi3_example_returns_where_it_says():
+    """The Python block of 'FMI 2.0 or FMI 3.0', run as written: its comment
+    names the onset and separation times (7 digits), and each appears twice."""
+    fmu3 = CONTACT.parent / "fraccontact-fmi3.fmu"
+    [block] = [body for heading, lang, body in fenced_blocks(README)
+               if heading == "FMI 2.0 or FMI 3.0" and lang == "python"]
+    namespace = {}
+    exec(compile(block.replace('"build/fraccontact-fmi3.fmu"', repr(str(fmu3))), "README.md (FMI 3.0)", "exec"),
+         namespace)
+    t = namespace["r"]["time"]
+    off_grid = t[np.abs(t / 1e-5 - np.round(t / 1e-5)) > 1e-6]
+    said = [float(x) * 1e-3 for x in re.findall(r"(\d+\.\d+) ms", block)]
+    assert len(off_grid) == 4 and len(said) == 2
+    for when in said:
+        assert np.count_nonzero(np.abs(off_grid - when) < 5e-11) == 2, (when, off_grid)
