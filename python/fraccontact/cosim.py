@@ -55,7 +55,7 @@ def monolithic(contact_fmu, t_end=3e-3, H=1e-5):
         t += H
     F_peak, eps, E_diss, v = c.get("F_peak", "eps", "E_diss", "v_striker")
     c.free()
-    return dict(F_peak=F_peak, eps=eps, energy_error=(0.5 * M * v * v + E_diss) / (0.5 * M * V0 * V0) - 1)
+    return dict(F_peak=F_peak, eps=eps, E_diss=E_diss, energy_error=(0.5 * M * v * v + E_diss) / (0.5 * M * V0 * V0) - 1)
 
 
 def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False):
@@ -88,7 +88,7 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     F_peak, E_diss = contact.get("F_peak", "E_diss")
     contact.free()
     striker.free()
-    result = dict(F_peak=F_peak, eps=-v_end / V0, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+    result = dict(F_peak=F_peak, eps=-v_end / V0, E_diss=E_diss, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
     if trace:
         result["series"] = series
     return result
@@ -121,7 +121,7 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
     ex.simulate_until(target_time=round(t_end * 1e9))
     F_peak, E_diss = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"]])
     v_end = observer.last_real_values(s, [svr["v"]])[0]
-    return dict(F_peak=F_peak, eps=-v_end / V0, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+    return dict(F_peak=F_peak, eps=-v_end / V0, E_diss=E_diss, energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
 
 
 def add_fmu_options(parser):
