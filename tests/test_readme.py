@@ -239,3 +239,17 @@ def test_the_readme_fmi3_example_returns_where_it_says():
     assert len(off_grid) == 4 and len(said) == 2
     for when in said:
         assert np.count_nonzero(np.abs(off_grid - when) < 5e-11) == 2, (when, off_grid)
+
+
+@pytest.mark.parametrize("master", ["fmpy", "libcosim"])
+def test_the_readme_ssp_examples_print_what_they_say(master, capsys):
+    """The Python blocks of 'The scene as SSP', run as written on this
+    build's drop_test.ssp: each prints the F_peak its comment names."""
+    ssp = os.environ.get("DROP_TEST_SSP", str(CONTACT.parent / "drop_test.ssp"))
+    blocks = [body for heading, lang, body in fenced_blocks(README)
+              if heading.startswith("The scene as SSP") and lang == "python"]
+    [block] = [b for b in blocks if ("libcosimpy" in b) == (master == "libcosim")]
+    exec(compile(block.replace('"build/drop_test.ssp"', repr(ssp)), f"README.md (SSP, {master})", "exec"), {})
+    printed = [float(x) for x in re.findall(r"[-\d.e+]+", capsys.readouterr().out)]
+    said = float(re.search(r"# (\d+\.\d+) N", block).group(1))
+    assert printed[0] == pytest.approx(said, abs=0.005)  # the comment's two decimals
