@@ -54,3 +54,75 @@ SEEDS = {
 for name, program in SEEDS.items():
     (HERE / "fuzz_corpus" / f"{name}.bin").write_bytes(program)
 print(f"wrote {len(SEEDS)} seeds to {HERE / 'fuzz_corpus'}")
+
+# --- FMI 3.0: the language of tests/fuzz_fmi3.c, seeds fmi3_*.bin -----------------------------------------
+# Its opcodes (the low 5 bits; 0x80 picks the second instance) and arguments:
+F3_INSTANTIATE, F3_FREE, F3_ENTER, F3_EXIT, F3_EVENT_MODE, F3_UPDATE, F3_STEP_MODE, F3_TERMINATE = range(8)
+F3_RESET, F3_SET_REAL, F3_SET_INT, F3_SET_BOOL, F3_OUTPUTS, F3_STEP, F3_GET_STATE, F3_SET_STATE = range(8, 16)
+F3_FREE_STATE, F3_SERIALIZE, F3_DESERIALIZE, F3_OUT_DER, F3_LOGGING, F3_REFUSED, F3_GET_INT_BOOL = range(16, 23)
+# F3_INSTANTIATE's flags byte
+LOGGING_ON, EVENT_MODE, EARLY_RETURN, CALLBACK = 1, 2, 4, 8
+WRONG_TOKEN, EMPTY_NAME, REQUIRED_VARIABLES = 0x10, 0x20, 0x40
+# F3_DESERIALIZE's mangling: flip a byte (else overwrite 8 bytes with a value), cut there, fix the checksum
+FLIP, CUT, FIX_CRC = 1, 2, 4
+
+
+def f3_start(flags=0, b=0, params=b""):
+    return (bytes([F3_INSTANTIATE | b, flags]) + params + bytes([F3_ENTER | b, V[0.0], 0, V[0.0], F3_EXIT | b])
+            + (bytes([F3_UPDATE | b, F3_STEP_MODE | b]) if flags & EVENT_MODE else b""))
+
+
+def f3_steps(n, H=1e-4, b=0, events=False):
+    """n steps from the model's time; with event mode after each (legal in step mode, needed after an event)."""
+    step = bytes([F3_STEP | b, V[H], 0, 0])
+    return (step + bytes([F3_EVENT_MODE | b, F3_UPDATE | b, F3_STEP_MODE | b]) if events else step) * n
+
+
+def f3_mangle(how, at, tail):
+    return bytes([F3_DESERIALIZE, 1, how, at & 0xFF, at >> 8]) + tail
+
+
+REF3 = {**REF, 0: 26}  # the same table, with time
+GAP = bytes([F3_SET_REAL, REF[12]]) + raw(1e-4)
+STATE_ROUND_TRIP = bytes([F3_GET_STATE, F3_SERIALIZE, F3_DESERIALIZE, 0])
+
+SEEDS3 = {
+    "fmi3_h20_plain": f3_start() + f3_steps(30) + bytes([F3_OUTPUTS]) + STATE_ROUND_TRIP
+    + bytes([F3_TERMINATE, F3_OUTPUTS, F3_FREE]),
+    "fmi3_gap_event_mode": f3_start(EVENT_MODE | EARLY_RETURN, params=GAP) + f3_steps(2, events=True)
+    + STATE_ROUND_TRIP + f3_steps(28, events=True) + bytes([F3_OUTPUTS, F3_EVENT_MODE, F3_TERMINATE, F3_RESET]),
+    "fmi3_gap_callback": f3_start(CALLBACK, params=GAP) + f3_steps(30) + bytes([F3_OUTPUTS, F3_OUT_DER, REF[13], 1]),
+    "fmi3_gap_early_callback": f3_start(EARLY_RETURN | CALLBACK | LOGGING_ON, params=GAP) + f3_steps(30)
+    + bytes([F3_OUTPUTS]),
+    "fmi3_event_mode_callback_gravity": f3_start(EVENT_MODE | CALLBACK, params=GAP + bytes([F3_SET_REAL, REF[11], V[9.81]]))
+    + f3_steps(30, 1e-4, events=True),
+    "fmi3_two_instances_state": f3_start(EVENT_MODE | EARLY_RETURN, params=GAP)
+    + f3_start(EVENT_MODE | EARLY_RETURN, 0x80) + f3_steps(4, events=True) + bytes([F3_GET_STATE, F3_EVENT_MODE | 0x80,
+                                                                                    F3_SET_STATE | 0x80, 0])
+    + f3_steps(10, b=0x80, events=True) + bytes([F3_FREE_STATE, 0, F3_FREE, F3_GET_INT_BOOL | 0x80, REF[40]]),
+    "fmi3_mangled_states": f3_start(params=bytes([F3_SET_INT, REF[33], 2])) + f3_steps(4)
+    + bytes([F3_GET_STATE, F3_SERIALIZE]) + f3_mangle(FIX_CRC, 40, bytes([V[1e3]]))
+    + bytes([F3_FREE_STATE, 1]) + f3_mangle(FLIP | FIX_CRC, 20, bytes([0x02]))
+    + bytes([F3_FREE_STATE, 1]) + f3_mangle(FLIP, 100, bytes([0x55]))
+    + f3_mangle(CUT | FIX_CRC, 200, raw(float("nan"))) + bytes([F3_FREE_STATE, 1])
+    + f3_mangle(FIX_CRC, 24, raw(float("inf"))) + f3_steps(2) + bytes([F3_OUTPUTS]),
+    "fmi3_out_of_order": bytes([F3_STEP, V[1e-4], 0, 0, F3_INSTANTIATE, WRONG_TOKEN, F3_INSTANTIATE, EMPTY_NAME,
+                                F3_INSTANTIATE, REQUIRED_VARIABLES, F3_INSTANTIATE, 0, F3_EVENT_MODE, F3_UPDATE,
+                                F3_STEP_MODE, F3_EXIT, F3_STEP, V[1e-4], 0, 0, F3_OUTPUTS, F3_ENTER, V[0.0], 1, V[0.5],
+                                F3_ENTER, V[0.0], 0, V[0.0], F3_SET_REAL, REF3[0], V[1e-4], F3_EXIT, F3_EVENT_MODE,
+                                F3_UPDATE, F3_TERMINATE, F3_STEP, V[1e-4], 0, 0, F3_RESET, F3_LOGGING, 1, 4,
+                                F3_LOGGING, 1, 2])
+    + b"".join(bytes([F3_REFUSED, REF[13], k, V[1e-4]]) for k in range(24)) + bytes([F3_FREE, F3_FREE]),
+    "fmi3_hostile_values": f3_start(EVENT_MODE | EARLY_RETURN | CALLBACK, params=bytes([F3_SET_REAL, REF[10]])
+                                    + raw(5e-324) + bytes([F3_SET_REAL, REF[1]]) + raw(1e300) + GAP)
+    + f3_steps(3, 1e3, events=True) + bytes([F3_STEP, V[1e-5], 1]) + raw(0.5) + bytes([0, F3_OUTPUTS])
+    + bytes([F3_STEP, V[1e-5], 1]) + raw(float("nan")) + bytes([0]),
+    "fmi3_springpot_full_history": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[33], 2, F3_SET_INT,
+                                                                                     REF[34], 1, F3_SET_REAL, REF[10],
+                                                                                     V[1e-5]]) + GAP)
+    + f3_steps(20, events=True) + STATE_ROUND_TRIP + f3_steps(5) + bytes([F3_TERMINATE, F3_FREE]),
+}
+
+for name, program in SEEDS3.items():
+    (HERE / "fuzz_corpus" / f"{name}.bin").write_bytes(program)
+print(f"wrote {len(SEEDS3)} FMI 3.0 seeds to {HERE / 'fuzz_corpus'}")
