@@ -344,17 +344,18 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     const fmu_variable *overflow;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     *event = 0;
-    fm_update_discrete(fm); /* a new step: the master has seen the last event */
-    /* About a minute of CPU: beyond that a step is a mistake, not a wish. */
+    /* A refused step changes nothing, so the checks come first. About a
+     * minute of CPU: beyond that a step is a mistake, not a wish. */
     if (H / fm->params.dt_max > 1e9)
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
                       "of dt_max = %g; take shorter communication steps or a larger dt_max", H, fm->params.dt_max);
+    if (H > 0.0 && contact_check_advance(cm, H, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
+    fm_update_discrete(fm); /* a new step: the master has seen the last event */
     cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
     if (H == 0.0)
         return FM_OK;
-    if (contact_check_advance(cm, H, why, sizeof why) != 0)
-        return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
     contact_drive(cm, fm->v, fm->m, fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
@@ -483,6 +484,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
         || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
+        || !(trial.model.s.F >= 0.0 && trial.model.s.F <= trial.model.s.F_peak)
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
     for (i = 0; i < count; i++)

@@ -7,7 +7,8 @@
 
 #include "serial.h"
 
-static const char *const type_names[] = {"Real", "Integer", "Boolean"};
+/* Named as both FMI versions call them. */
+static const char *const type_names[] = {"a Real (Float64)", "an Integer (Int32)", "a Boolean"};
 
 fm_status fmu_say(const fmu_reporter *r, fm_status status, const char *category, const char *fmt, ...)
 {
@@ -27,7 +28,7 @@ const fmu_variable *fmu_find(const fmu_variables *vars, unsigned vr, var_type ty
     for (i = 0; i < vars->count; i++)
         if (vars->list[i].vr == vr && vars->list[i].type == type)
             return &vars->list[i];
-    fmu_say(r, FM_ERROR, "logStatusError", "value reference %u is not a %s variable of this FMU", vr,
+    fmu_say(r, FM_ERROR, "logStatusError", "value reference %u is not %s variable of this FMU", vr,
             type_names[type]);
     return NULL;
 }
@@ -44,7 +45,7 @@ const fmu_variable *fmu_settable(const fmu_variables *vars, unsigned vr, var_typ
     }
     if (var->causality == VAR_PARAMETER && started) {
         fmu_say(r, FM_ERROR, "logStatusError",
-                "%s is a fixed parameter; it can be set only before fmi2ExitInitializationMode", var->name);
+                "%s is a fixed parameter; it can be set only before ExitInitializationMode", var->name);
         return NULL;
     }
     return var;

@@ -1004,10 +1004,12 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
     double steps = H / cm->p.dt_max, whole = floor(steps + 0.5);
     if (!full_history(cm))
         return 0;
-    if (fabs(steps - whole) > 1e-9 * fmax(1.0, whole)) {
+    /* A sliver within the forgiveness of a whole step would be no step at
+     * all here, but one step of dt_max for contact_advance. */
+    if (whole < 1.0 || fabs(steps - whole) > 1e-9 * fmax(1.0, whole)) {
         snprintf(msg, len,
                  "memory = 1 (the full G1 history) steps on a uniform grid of dt_max = %.17g s: an advance by "
-                 "%.17g s is not a whole number of its steps (use memory = 2 for any step)",
+                 "%.17g s is not a whole number (at least 1) of its steps (use memory = 2 for any step)",
                  cm->p.dt_max, H);
         return -1;
     }
