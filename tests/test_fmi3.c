@@ -9,7 +9,11 @@
  * Usage: test_fmi3 <path of the FMI 2.0 FMU's shared library> */
 #define _POSIX_C_SOURCE 200809L
 
+#ifdef _WIN32
+#include <windows.h>
+#else
 #include <dlfcn.h>
+#endif
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -422,11 +426,30 @@ typedef struct {
 
 static fmi2_fmu fmi2;
 
-/* dlsym's object pointer into a function pointer, without the cast that ISO C
- * does not define (POSIX guarantees the representations agree). */
+/* The loader's calls, on POSIX and on Windows (where the test runs under Wine). */
+#ifdef _WIN32
+static void *open_library(const char *path) { return (void *)LoadLibraryA(path); }
+static void *library_symbol(void *library, const char *name)
+{
+    FARPROC f = GetProcAddress((HMODULE)library, name);
+    void *symbol;
+    memcpy(&symbol, &f, sizeof symbol);
+    return symbol;
+}
+static const char *library_error(void) { return "LoadLibrary failed"; }
+static void close_library(void *library) { FreeLibrary((HMODULE)library); }
+#else
+static void *open_library(const char *path) { return dlopen(path, RTLD_NOW | RTLD_LOCAL); }
+static void *library_symbol(void *library, const char *name) { return dlsym(library, name); }
+static const char *library_error(void) { return dlerror(); }
+static void close_library(void *library) { dlclose(library); }
+#endif
+
+/* The symbol's object pointer into a function pointer, without the cast that
+ * ISO C does not define (POSIX and Windows guarantee the representations agree). */
 static int load(void *fn, const char *name)
 {
-    void *symbol = dlsym(fmi2.library, name);
+    void *symbol = library_symbol(fmi2.library, name);
     memcpy(fn, &symbol, sizeof symbol);
     CHECK(symbol != NULL, "the FMI 2.0 FMU exports %s", name);
     return symbol != NULL;
@@ -435,9 +458,9 @@ static int load(void *fn, const char *name)
 static int load_fmi2(const char *path)
 {
     int ok = 1;
-    fmi2.library = path ? dlopen(path, RTLD_NOW | RTLD_LOCAL) : NULL;
+    fmi2.library = path ? open_library(path) : NULL;
     CHECK(fmi2.library != NULL, "load the FMI 2.0 FMU %s: %s", path ? path : "(no path given)",
-          path ? dlerror() : "usage: test_fmi3 <fraccontact.so of the FMI 2.0 FMU>");
+          path ? library_error() : "usage: test_fmi3 <fraccontact.so of the FMI 2.0 FMU>");
     if (!fmi2.library)
         return 0;
     ok &= load(&fmi2.instantiate, "fmi2Instantiate");
@@ -454,7 +477,7 @@ static int load_fmi2(const char *path)
     ok &= load(&fmi2.free_instance, "fmi2FreeInstance");
     /* The two libraries keep their models apart (hidden symbols): the 2.0
      * one does not answer to fmi3 calls. */
-    CHECK(dlsym(fmi2.library, "fmi3DoStep") == NULL, "the FMI 2.0 FMU exports no fmi3 function");
+    CHECK(library_symbol(fmi2.library, "fmi3DoStep") == NULL, "the FMI 2.0 FMU exports no fmi3 function");
     return ok;
 }
 
@@ -1115,6 +1138,6 @@ int main(int argc, char **argv)
     test_unsupported();
     test_independent_instances();
     if (fmi2.library)
-        dlclose(fmi2.library);
+        close_library(fmi2.library);
     return check_summary("test_fmi3");
 }
