@@ -21,49 +21,9 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
+#include "fuzz_program.h"
 #include "guid.h"
-
-/* ------------------------------------------------------- reading the program */
-
-typedef struct {
-    const uint8_t *at, *end;
-} program;
-
-static int more(const program *p, size_t n)
-{
-    return (size_t)(p->end - p->at) >= n;
-}
-
-static uint8_t byte(program *p)
-{
-    return more(p, 1) ? *p->at++ : 0;
-}
-
-/* fuzz_fmi2.c's table, so that both harnesses probe the same numbers */
-static const double interesting[] = {0.0, -0.0, 1.0, -1.0, 0.5, 1e-7, 1e-5, 1e-4, 1e-3, 3e-3, 1.0,
-                                     0.626418, 0.7437, 3.299e8, 6080.0, 6.35e-3, 2.64e9, 210e9, 0.3, 0.4,
-                                     9.81, 1e-15, 1e3, 1e300, -1e300, 5e-324, 2.2250738585072014e-308};
-
-static double value(program *p)
-{
-    uint8_t b = byte(p);
-    if (b & 0x80 && more(p, 8)) {
-        double d;
-        memcpy(&d, p->at, 8);
-        p->at += 8;
-        return d;
-    }
-    return interesting[b % (sizeof interesting / sizeof interesting[0])];
-}
-
-/* The FMU's references (0 = time, 1..40) most of the time, anything else too;
- * new ones only at the end, so that the corpus keeps its meaning. */
-static fmi3ValueReference reference(program *p)
-{
-    static const fmi3ValueReference known[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
-                                               21, 22, 30, 31, 32, 40, 0, 99, 0xFFFFFFFFu, 23, 24, 25, 26, 33, 34};
-    return known[byte(p) % (sizeof known / sizeof known[0])];
-}
+#include "serial.h"
 
 /* ------------------------------------------------------------- invariants */
 
@@ -213,19 +173,6 @@ static void do_step(fmi3Instance x, instance_info *info, program *p)
 
 /* ------------------------------------------------------------- FMU states */
 
-static uint32_t crc32_of(const uint8_t *bytes, size_t n)
-{
-    uint32_t crc = 0xFFFFFFFFu;
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        crc ^= bytes[i];
-        for (k = 0; k < 8; k++)
-            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
-
 /* A state's bytes mangled: a byte flipped or 8 bytes overwritten by a value,
  * maybe cut short, and maybe its checksum made right again (the layout of
  * fmu_instance.c: the payload's CRC-32 at 16, the payload from 20), so that
@@ -244,7 +191,7 @@ static size_t mangle(program *p, uint8_t *bytes, size_t size)
     if (how & 2)
         size = at;
     if ((how & 4) && size >= 20) {
-        uint32_t crc = crc32_of(bytes + 20, size - 20);
+        uint32_t crc = serial_crc32(bytes + 20, size - 20);
         size_t i;
         for (i = 0; i < 4; i++)
             bytes[16 + i] = (uint8_t)(crc >> (8 * i));
