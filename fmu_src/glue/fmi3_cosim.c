@@ -437,12 +437,13 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
 {
     instance *in = c;
     const double t = currentCommunicationPoint, end = t + communicationStepSize;
-    const unsigned stop = in && (in->early_return_allowed || in->intermediate_update) ? FM_STOP_AT_EVENT : 0u;
-    unsigned options = stop;
+    unsigned stop, options;
     double now = t;
     int event = 0;
     (void)noSetFMUStatePriorToCurrentPoint;
     REQUIRE(STEP_MODE, "fmi3DoStep");
+    stop = in->early_return_allowed || in->intermediate_update ? FM_STOP_AT_EVENT : 0u;
+    options = stop;
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime)
         return fail(in, "fmi3DoStep: an output argument is NULL");
     *eventHandlingNeeded = *terminateSimulation = *earlyReturn = fmi3False;
