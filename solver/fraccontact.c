@@ -27,6 +27,8 @@ static const fc_parameter parameters[] = {
     {"c_alpha", FC_REAL, AT(c_alpha), "N.s^alpha/m", "springpot constant: F = c_alpha D^alpha x2 (damper 2)"},
     {"memory_tolerance", FC_REAL, AT(memory_tolerance), "1",
      "relative error of the compressed memory's kernel, from dt_max to 1000 s (memory 2)"},
+    {"tolerance", FC_REAL, AT(tolerance), "1",
+     "relative error per internal step (error-controlled ESDIRK steps of at most dt_max); 0 = fixed steps of dt_max"},
     {"dt_max", FC_REAL, AT(dt_max), "s", "largest internal step"},
     {"g", FC_REAL, AT(g), "m/s2", "acceleration of the striker towards the specimen (9.81 for gravity)"},
     {"gap0", FC_REAL, AT(gap0), "m", "gap between striker and specimen at t = 0"},
@@ -64,6 +66,7 @@ void fc_model_params(const fc_params *p, contact_params *q)
     q->damper_order = p->damper_order;
     q->c_alpha = p->c_alpha;
     q->memory_tolerance = p->memory_tolerance;
+    q->tolerance = p->tolerance;
     q->dt_max = p->dt_max;
     q->g = p->g;
     q->gap0 = p->gap0;
@@ -92,6 +95,7 @@ void fc_params_default(fc_params *p)
     p->damper_order = q.damper_order;
     p->c_alpha = q.c_alpha;
     p->memory_tolerance = q.memory_tolerance;
+    p->tolerance = q.tolerance;
     p->dt_max = q.dt_max;
     p->g = q.g;
     p->gap0 = q.gap0;

@@ -60,6 +60,7 @@ typedef struct {
     double damper_order;     /* the springpot's alpha in (0, 1] */
     double c_alpha;          /* springpot constant [N s^alpha/m] */
     double memory_tolerance; /* relative error of the compressed memory's kernel */
+    double tolerance;        /* relative error per internal step; 0: fixed steps of dt_max */
     double dt_max;   /* largest internal step [s] */
     double g;        /* acceleration of the striker towards the specimen [m/s^2] */
     double gap0;     /* gap between striker and specimen at t = 0 [m] */

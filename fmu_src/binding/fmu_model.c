@@ -40,6 +40,7 @@ static const fmu_variable variable_list[] = {
     {VR_damper_order, "damper_order", VAR_REAL, VAR_PARAMETER, PARAM(damper_order)},
     {VR_c_alpha, "c_alpha", VAR_REAL, VAR_PARAMETER, PARAM(c_alpha)},
     {VR_memory_tolerance, "memory_tolerance", VAR_REAL, VAR_PARAMETER, PARAM(memory_tolerance)},
+    {VR_tolerance, "tolerance", VAR_REAL, VAR_PARAMETER, PARAM(tolerance)},
     {VR_dt_max, "dt_max", VAR_REAL, VAR_PARAMETER, PARAM(dt_max)},
     {VR_g, "g", VAR_REAL, VAR_PARAMETER, PARAM(g)},
     {VR_gap0, "gap0", VAR_REAL, VAR_PARAMETER, PARAM(gap0)},
@@ -407,7 +408,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
 
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
-    F(params.dt_max), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
+    F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), F(step_span),
     I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};

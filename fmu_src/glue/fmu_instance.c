@@ -138,7 +138,7 @@ fi_status fi_check_step(const fmu_instance *in, double t, double H, int zero_all
  * mode and start time, then the model's state (fm_state_write). All
  * integers little-endian. */
 #define STATE_MAGIC "FCST"
-#define STATE_FORMAT 3u
+#define STATE_FORMAT 4u
 #define STATE_HEADER 20u
 #define STATE_INSTANCE 12u /* mode (u32), start time (f64) */
 

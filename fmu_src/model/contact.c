@@ -1,5 +1,6 @@
 #include "contact.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,6 +46,7 @@ void contact_default_params(contact_params *p)
     p->damper_order = 0.5;
     p->c_alpha = 3e5;
     p->memory_tolerance = 1e-6;
+    p->tolerance = 0.0;
     p->dt_max = 1e-7;
     p->g = 0.0;
     p->gap0 = 0.0;
@@ -155,6 +157,22 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
     if (!(p->memory_tolerance >= 1e-12 && p->memory_tolerance <= 1e-2))
         return contact_reject(msg, len, "memory_tolerance", p->memory_tolerance,
                               "the compressed memory's kernel tolerance must lie in [1e-12, 1e-2]");
+    if (!(p->tolerance == 0.0 || (p->tolerance >= 1e-12 && p->tolerance <= 1e-2)))
+        return contact_reject(msg, len, "tolerance", p->tolerance,
+                              "the relative error per internal step must be 0 (fixed steps of dt_max) or lie in "
+                              "[1e-12, 1e-2]");
+    if (p->tolerance > 0.0 && p->law != CONTACT_LAW_HERTZ && p->g1_nodes == 0)
+        return contact_reject(msg, len, "tolerance", p->tolerance,
+                              "error-controlled steps need a force that does not depend on the step count: with "
+                              "g1_nodes = 0 the G1 laws count internal steps; set g1_nodes > 0 or law = 2");
+    if (p->tolerance > 0.0 && p->scheme == CONTACT_SCHEME_CENTRAL)
+        return contact_reject(msg, len, "tolerance", p->tolerance,
+                              "error-controlled steps are implicit (ESDIRK): the central differences (scheme = 2) "
+                              "take fixed steps; use scheme = 1");
+    if (p->tolerance > 0.0 && p->damper == CONTACT_DAMPER_SPRINGPOT)
+        return contact_reject(msg, len, "tolerance", p->tolerance,
+                              "error-controlled steps drive the dashpot (damper = 1) so far; the springpot takes "
+                              "fixed steps of dt_max (tolerance = 0)");
     if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->scheme == CONTACT_SCHEME_CENTRAL)
         return contact_reject(msg, len, "scheme", p->scheme,
                               "the central differences (2) drive the dashpot only; the springpot (damper = 2) needs 1");
@@ -584,6 +602,132 @@ static double sdirk_step(contact_model *cm, const contact_state *in, double h, d
     return sdirk_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }
 
+/* ------------------------------------------------ error-controlled steps */
+#ifndef ESDIRK_INDEX
+#define ESDIRK_INDEX 0
+#endif
+#define ESDIRK (esdirk_methods[ESDIRK_INDEX])
+
+#define ESDIRK_MAX_STAGES 7
+
+/* An ESDIRK method: an explicit first stage, then implicit stages of one
+ * diagonal gamma; stiffly accurate (the last stage is the step's end, so
+ * L-stable methods damp what a long step cannot resolve), with an embedded
+ * solution of one order less that is itself a stage, `embedded`: the
+ * difference of the two stages estimates the step's error. */
+typedef struct {
+    int stages, embedded;
+    double exponent; /* 1/(embedded order + 1): the error's power of h */
+    double a[ESDIRK_MAX_STAGES][ESDIRK_MAX_STAGES];
+} esdirk_method;
+
+/* Kvaerno's ESDIRK of order 3 with an embedded order 2, both L-stable
+ * (A. Kvaerno, BIT 44 (2004) 489-502; coefficients to 16 digits). */
+#define KVAERNO3_GAMMA 0.4358665215084589994
+static const esdirk_method kvaerno3 = {
+    4, 2, 1.0 / 3.0,
+    {{0.0},
+     {KVAERNO3_GAMMA, KVAERNO3_GAMMA},
+     {0.4905633884217805706, 0.07357009006976042996, KVAERNO3_GAMMA},
+     {0.3088099699767465233, 1.490563388421780571, -1.235239879906986093, KVAERNO3_GAMMA}}};
+
+/* Kvaerno's ESDIRK of order 5 with an embedded order 4, both L-stable
+ * (the same paper). */
+#define KVAERNO5_GAMMA 0.26
+static const esdirk_method kvaerno5 = {
+    7, 5, 1.0 / 5.0,
+    {{0.0},
+     {KVAERNO5_GAMMA, KVAERNO5_GAMMA},
+     {0.13, 0.8403332099679080963, KVAERNO5_GAMMA},
+     {0.2237196147832050559, 0.4767553231979969983, -0.06470895363112615134, KVAERNO5_GAMMA},
+     {0.1664856432324832153, 0.1045001884159172041, 0.03631482272098715162, -0.1309070445107399857, KVAERNO5_GAMMA},
+     {0.1385564023126822495, 0.0, -0.04245337201752043099, 0.02446657898003141966, 0.6194303907248067618,
+      KVAERNO5_GAMMA},
+     {0.1365975117764029144, 0.0, -0.05496908796538376712, -0.04118626728321046868, 0.6299330489901640319,
+      0.06962479448202728949, KVAERNO5_GAMMA}}};
+
+static const esdirk_method *const esdirk_methods[] = {&kvaerno3, &kvaerno5};
+
+/* The length scale of an error-controlled step's error: the elastic
+ * indentation at its ends (relative error in x1 is relative error in the
+ * force, and near onset and separation, where x1^n is not smooth, it grades
+ * the steps as x1 falls to 0), never 0. */
+static double error_length(double x1_start, double x1_end)
+{
+    return fmax(fmax(fabs(x1_start), fabs(x1_end)), DBL_MIN);
+}
+
+/* One ESDIRK step of length h from *in with spring stiffness K, the dashpot
+ * damping (the same contract as sdirk_step); out->error is the embedded
+ * estimate of its error over the tolerance: x1 and x2 relative to the
+ * indentation, v relative to the speed at onset or now. */
+static double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    const esdirk_method *m = ESDIRK;
+    const int last = m->stages - 1;
+    const damper_stage dashpot = {0.0, cm->inv_c};
+    double F[ESDIRK_MAX_STAGES], x1_rate[ESDIRK_MAX_STAGES], v_rate[ESDIRK_MAX_STAGES];
+    double X = in->x1, V = in->v, X_embedded = 0.0, V_embedded = 0.0, x2_embedded = 0.0;
+    double impulse = 0.0, work = 0.0, x2_step = 0.0, length, speed;
+    int i, j;
+    F[0] = in->F;
+    for (i = 0; i <= last; i++) {
+        if (i > 0) {
+            double xh = in->x1, vh = in->v;
+            for (j = 0; j < i; j++) {
+                xh += h * m->a[i][j] * x1_rate[j];
+                vh += h * m->a[i][j] * v_rate[j];
+            }
+            F[i] = implicit_stage(cm, K, m->a[i][i] * h, xh, vh, dashpot, &X, &V);
+        }
+        x1_rate[i] = V - F[i] * cm->inv_c;
+        v_rate[i] = cm->accel - cm->inv_m * F[i];
+        if (i == m->embedded) {
+            X_embedded = X;
+            V_embedded = V;
+            for (j = 0; j <= i; j++)
+                x2_embedded += h * m->a[i][j] * F[j] * cm->inv_c;
+        }
+    }
+    for (j = 0; j <= last; j++) {
+        impulse += h * m->a[last][j] * F[j];
+        work += h * m->a[last][j] * F[j] * F[j] * cm->inv_c;
+    }
+    x2_step = impulse * cm->inv_c;
+    length = error_length(in->x1, X);
+    speed = fmax(fmax(fabs(in->v), fabs(V)), fmax(fabs(in->v_onset), DBL_MIN));
+    *out = *in;
+    out->t = in->t + h;
+    out->x1 = X;
+    out->v = V;
+    out->F = F[last];
+    out->x2 = in->x2 + x2_step;
+    out->E_diss = in->E_diss + work;
+    out->step = h;
+    out->x2_rate1 = F[1] * cm->inv_c;
+    out->x2_rate = F[last] * cm->inv_c;
+    out->error = fmax(fmax(fabs(X - X_embedded) / length, fabs(x2_step - x2_embedded) / length),
+                      fabs(V - V_embedded) / speed) / cm->p.tolerance;
+    return impulse;
+}
+
+static int error_controlled(const contact_model *cm) { return cm->p.tolerance > 0.0; }
+
+/* A contact step of length h: error-controlled or fixed. */
+static double contact_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    return error_controlled(cm) ? esdirk_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
+}
+
+/* The step after one with error ratio `error` (error over tolerance) of
+ * length h: the usual controller with a safety factor 0.9, growing at most
+ * 5-fold and shrinking at most 10-fold. */
+static double next_step(double h, double error, double exponent)
+{
+    double factor = error > 0.0 ? 0.9 * pow(error, -exponent) : 5.0;
+    return h * fmin(5.0, fmax(0.1, factor));
+}
+
 /* Makes a trial step the model's state, and its memory follow. */
 static inline void accept_step(contact_model *cm, const contact_state *trial)
 {
@@ -673,13 +817,13 @@ static double event_time(contact_model *cm, const contact_state *s, double h, do
 {
     double lo = 0.0, hi = h, flo = event(cm, s), fhi = f_end;
     int i, side = 0;
-    sdirk_step(cm, s, h, K, at);
+    contact_step(cm, s, h, K, at);
     for (i = 0; i < 200 && fhi != 0.0 && hi - lo > 1e-15 * h; i++) {
         contact_state trial;
         double tau = (lo * fhi - hi * flo) / (fhi - flo), f;
         if (!(tau > lo && tau < hi))
             tau = 0.5 * (lo + hi);
-        sdirk_step(cm, s, tau, K, &trial);
+        contact_step(cm, s, tau, K, &trial);
         f = event(cm, &trial);
         if (f > 0.0) {
             lo = tau;
@@ -810,6 +954,53 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
         h -= tau;
     }
     return -1;
+}
+
+/* A bound on the rejected trials of one error-controlled step: each
+ * shrinks it at least 10-fold, so only a diverging state reaches it. */
+#define MAX_REJECTED_STEPS 40
+
+/* One accepted error-controlled contact step of at most `remaining`, cut
+ * at separation: 0, 1 when it stopped at separation with CONTACT_SEPARATION
+ * in stop_at, or -1 when no step length is accepted (a diverging state);
+ * *advanced is the length stepped. */
+static int controlled_internal_step(contact_model *cm, double remaining, double *impulse, unsigned stop_at,
+                                    double *advanced)
+{
+    contact_state *s = &cm->s, trial;
+    const double K = contact_spring_stiffness(cm, s->n + 1);
+    double h = s->h_next > 0.0 ? s->h_next : cm->p.dt_max, tau = 0.0, J = 0.0, peak, h_next;
+    int rejected, separates = 0;
+    for (rejected = 0; rejected <= MAX_REJECTED_STEPS; rejected++) {
+        h = fmin(h, cm->p.dt_max);
+        /* the last step lands on the interval's end (forgiving a few ulp) */
+        tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
+        J = esdirk_step(cm, s, tau, K, &trial);
+        separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
+        if (separates) {
+            tau = event_time(cm, s, tau, K, indentation, trial.x1, &trial);
+            J = esdirk_step(cm, s, tau, K, &trial);
+        }
+        if (trial.error <= 1.0)
+            break;
+        h = next_step(tau, trial.error, ESDIRK->exponent);
+    }
+    if (rejected > MAX_REJECTED_STEPS)
+        return -1;
+    /* A step cut short by the interval or the separation keeps the length
+     * the error allowed for the next one. */
+    h_next = fmax(next_step(tau, trial.error, ESDIRK->exponent), tau < h ? h : 0.0);
+    peak = peak_force_within(cm, s, tau, K, &trial);
+    accept_step(cm, &trial);
+    s->h_next = h_next;
+    count_contact_step(s, peak);
+    *impulse += J;
+    *advanced = tau;
+    if (!separates)
+        return 0;
+    s->x1 = 0.0;
+    end_contact(s, s->t, s->v);
+    return (stop_at & CONTACT_SEPARATION) != 0;
 }
 
 /* ------------------------------------------------- the full G1 history */
@@ -1067,6 +1258,16 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
             }
             remaining -= tau;
             stopped = touches && (stop_at & CONTACT_ONSET);
+            continue;
+        }
+        if (error_controlled(cm)) {
+            double advanced = 0.0;
+            int status;
+            cm->s.steps++;
+            status = controlled_internal_step(cm, remaining, &impulse, stop_at, &advanced);
+            failed = status < 0;
+            stopped = status > 0;
+            remaining = advanced < remaining ? remaining - advanced : 0.0;
             continue;
         }
         /* In contact: equal steps of at most dt_max over the rest, rounding

@@ -60,6 +60,7 @@ typedef struct {
     double damper_order; /* alpha of the springpot, in (0, 1] */
     double c_alpha;      /* springpot constant [N s^alpha/m] */
     double memory_tolerance; /* relative error of the compressed memory's kernel */
+    double tolerance;    /* relative error per internal step; 0: fixed steps of dt_max */
     double dt_max;       /* largest internal step [s] */
     double g;            /* acceleration of the model's striker towards the specimen [m/s^2] */
     double gap0;         /* gap between striker and specimen at the start [m] */
@@ -90,11 +91,13 @@ typedef struct {
     double x_prev;    /* central differences and the full G1 history's BDF2: */
     double h_prev;    /* total indentation one step back, and that step (0: restart) */
     int64_t impacts;  /* finished impacts */
+    double h_next;    /* the error control's next step (tolerance > 0; 0: none yet) */
     int in_contact;
     /* Not part of the state carried from step to step (so not listed
      * below): what a trial step leaves for accepting it, its length and
-     * the damper's rate x2' at its two stages (the second is the end's). */
-    double step, x2_rate1, x2_rate;
+     * the damper's rate x2' at its two stages (the second is the end's),
+     * and an error-controlled step's error over the tolerance. */
+    double step, x2_rate1, x2_rate, error;
 } contact_state;
 
 /* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,
@@ -104,7 +107,7 @@ typedef struct {
 #define CONTACT_STATE_FIELDS(DOUBLE, INT64, INT)                                                          \
     DOUBLE(t) DOUBLE(x1) DOUBLE(x2) DOUBLE(v) DOUBLE(F) DOUBLE(F_peak) DOUBLE(F_peak_contact) DOUBLE(E_diss) \
     DOUBLE(eps) DOUBLE(v_onset) DOUBLE(t_onset) DOUBLE(t_contact) DOUBLE(x_prev) DOUBLE(h_prev)            \
-    INT64(n) INT64(steps) INT64(impacts) INT(in_contact)
+    INT64(n) INT64(steps) INT64(impacts) DOUBLE(h_next) INT(in_contact)
 
 /* The compressed memory (a springpot with memory = 2): the kernel's modes,
  * their state, and the coefficients of one step length. */
