@@ -141,6 +141,8 @@ typedef struct {
     double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
+    double root_precision;  /* relative accuracy an implicit stage's root needs (0: to rounding) */
+    double peak_force_seen, peak_length; /* error control's cache: a force and its elastic indentation */
     contact_state s;
     contact_modes modes;      /* a springpot's compressed memory */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
