@@ -109,11 +109,16 @@ def test_bad_tolerances_are_refused_naming_the_value(value, rule):
 
 
 @pytest.mark.parametrize("params, why", [
-    (dict(law="g1"), "g1_nodes"), (dict(law="hertz", scheme="central"), "central"),
+    (dict(law="g1"), "g1_nodes = 0"), (dict(law="hertz", scheme="central"), "central"),
     (dict(law="hertz", damper=2), "springpot")])
-def test_where_the_force_depends_on_the_steps_it_is_refused(params, why):
-    with pytest.raises(ValueError, match=r"tolerance = 1e-06 is invalid: .*" + why):
-        fraccontact.impact(tolerance=1e-6, **params)
+def test_where_steps_stay_fixed_it_warns_and_changes_nothing(params, why):
+    """The G1 laws with N = steps since onset (their error is defined by the
+    step count), the central scheme and the springpot keep fixed steps of
+    dt_max: a warning names the tolerance, and the run is the fixed one."""
+    assert fraccontact.warning(tolerance=1e-6, **params).startswith("tolerance = 1e-06 has no effect")
+    assert why in fraccontact.warning(tolerance=1e-6, **params)
+    fixed, ignored = fraccontact.impact(**params), fraccontact.impact(tolerance=1e-6, **params)
+    assert (ignored.F_peak, ignored.eps, ignored.steps) == (fixed.F_peak, fixed.eps, fixed.steps)
 
 
 def test_driven_at_a_constant_rate_the_rigid_limit_is_exact():

@@ -161,18 +161,6 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return contact_reject(msg, len, "tolerance", p->tolerance,
                               "the relative error per internal step must be 0 (fixed steps of dt_max) or lie in "
                               "[1e-12, 1e-2]");
-    if (p->tolerance > 0.0 && p->law != CONTACT_LAW_HERTZ && p->g1_nodes == 0)
-        return contact_reject(msg, len, "tolerance", p->tolerance,
-                              "error-controlled steps need a force that does not depend on the step count: with "
-                              "g1_nodes = 0 the G1 laws count internal steps; set g1_nodes > 0 or law = 2");
-    if (p->tolerance > 0.0 && p->scheme == CONTACT_SCHEME_CENTRAL)
-        return contact_reject(msg, len, "tolerance", p->tolerance,
-                              "error-controlled steps are implicit (ESDIRK): the central differences (scheme = 2) "
-                              "take fixed steps; use scheme = 1");
-    if (p->tolerance > 0.0 && p->damper == CONTACT_DAMPER_SPRINGPOT)
-        return contact_reject(msg, len, "tolerance", p->tolerance,
-                              "error-controlled steps drive the dashpot (damper = 1) so far; the springpot takes "
-                              "fixed steps of dt_max (tolerance = 0)");
     if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->scheme == CONTACT_SCHEME_CENTRAL)
         return contact_reject(msg, len, "scheme", p->scheme,
                               "the central differences (2) drive the dashpot only; the springpot (damper = 2) needs 1");
@@ -253,9 +241,35 @@ static int unused_damper_value(const contact_params *p, char *msg, size_t len)
     return 1;
 }
 
+/* Why error-controlled steps do not apply with these parameters, or NULL:
+ * they need a force that does not depend on the step count and the
+ * implicit scheme; the springpot takes fixed steps so far. */
+static const char *fixed_steps_only(const contact_params *p)
+{
+    if (p->law != CONTACT_LAW_HERTZ && p->g1_nodes == 0)
+        return "with g1_nodes = 0 the G1 laws count internal steps, whose number defines their error, so they "
+               "take fixed steps of dt_max (set g1_nodes > 0 or law = 2 for error-controlled steps)";
+    if (p->scheme == CONTACT_SCHEME_CENTRAL)
+        return "the central differences (scheme = 2) take fixed steps of dt_max";
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT)
+        return "the springpot (damper = 2) takes fixed steps of dt_max";
+    return NULL;
+}
+
+static int tolerance_applies(const contact_params *p) { return p->tolerance > 0.0 && !fixed_steps_only(p); }
+
+static int unused_tolerance(const contact_params *p, char *msg, size_t len)
+{
+    char text[32];
+    if (!(p->tolerance > 0.0) || !fixed_steps_only(p))
+        return 0;
+    snprintf(msg, len, "tolerance = %s has no effect: %s", shown(p->tolerance, text), fixed_steps_only(p));
+    return 1;
+}
+
 int contact_unused_value(const contact_params *p, char *msg, size_t len)
 {
-    return unused_material(p, msg, len) || unused_damper_value(p, msg, len);
+    return unused_material(p, msg, len) || unused_damper_value(p, msg, len) || unused_tolerance(p, msg, len);
 }
 
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len)
@@ -310,7 +324,8 @@ void contact_configure(contact_model *cm, const contact_params *p)
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
-    cm->root_precision = 1e-3 * p->tolerance;
+    cm->error_controlled = tolerance_applies(p);
+    cm->root_precision = cm->error_controlled ? 1e-3 * p->tolerance : 0.0;
     cm->peak_force_seen = -1.0;
     cm->peak_length = 0.0;
     cm->modes.modes = 0;
@@ -709,7 +724,7 @@ static double esdirk_step(contact_model *cm, const contact_state *in, double h, 
     return impulse;
 }
 
-static int error_controlled(const contact_model *cm) { return cm->p.tolerance > 0.0; }
+static int error_controlled(const contact_model *cm) { return cm->error_controlled; }
 
 /* A contact step of length h: error-controlled or fixed. */
 static double contact_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
