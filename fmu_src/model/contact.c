@@ -413,9 +413,11 @@ static double stage_root(double r, double beta, double precision)
     double s = sqrt(r), u = beta * s, ds;
     int i;
     if (u < 0.05) {
-        const double u2 = u * u;
-        s *= 1.0 - u * (0.5 - u * (0.625 - u * (1.0 - u * (231.0 / 128.0 - u * (3.5 - u * (7293.0 / 1024.0))))));
-        if (u < 1e-4 || 20.0 * u2 * u2 * u2 * u < precision)
+        /* Estrin's scheme: pairs of terms side by side, a shorter chain of
+         * dependent operations than Horner's on every implicit stage */
+        const double u2 = u * u, u4 = u2 * u2;
+        s *= (1.0 - 0.5 * u) + u2 * (0.625 - u) + u4 * ((231.0 / 128.0 - 3.5 * u) + u2 * (7293.0 / 1024.0));
+        if (u < 1e-4 || 20.0 * u4 * u2 * u < precision)
             return s;
     } else {
         s = u > 1.0 ? cbrt(r / beta) : s / (1.0 + 0.5 * u);
