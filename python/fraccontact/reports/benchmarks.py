@@ -24,7 +24,7 @@ Writes docs/benchmarks.md and docs/benchmarks_work_precision.png. Medians of
 repeated runs; CPU time of one process for 1 to 3, 5 and the per-impact costs
 of 4, wall time for 4's sweeps and fit.
 
-Regenerate: scripts/report benchmarks   (about 25 minutes)
+Regenerate: scripts/report benchmarks   (about 20 minutes)
             scripts/report benchmarks --only precision   (section 2 alone, in place)
             scripts/report benchmarks --only package     (section 4 alone, in place)
             scripts/report benchmarks --only springpot   (section 5 alone, in place)
@@ -69,8 +69,8 @@ SPRINGPOT_BEGIN, SPRINGPOT_END = "<!-- springpot: begin -->", "<!-- springpot: e
 # match; rounds alternating its fraccontact-bench and this build's.
 BASE = "65bf8cb"
 BASE_ROUNDS = 7
-REGENERATE = ("Regenerate: `scripts/report benchmarks` (about 25 minutes; the work against precision alone: "
-              "`scripts/report benchmarks --only precision`, about 5; the springpot's section alone: "
+REGENERATE = ("Regenerate: `scripts/report benchmarks` (about 20 minutes; the work against precision alone: "
+              "`scripts/report benchmarks --only precision`, about 1; the springpot's section alone: "
               "`scripts/report benchmarks --only springpot`, about 12)")
 
 
@@ -335,7 +335,7 @@ def plot_precision(path, r):
     """Work against precision: the largest error of each case's figures
     against CPU per impact, a line per method, the cheapest meeting
     setting ringed."""
-    fig, axes = plt.subplots(1, 2, figsize=(14, 6))
+    fig, axes = plt.subplots(1, 2, figsize=(14, 6.6))
     titles = {"h20": "h20 (v = sqrt(2 g 0.02)): largest error of F_peak, eps, t_contact, x2_end",
               "soft": "soft dashpot (c = 50, v = 3, 10 ms): error of F_peak"}
     for ax, (name, methods) in zip(axes, r["results"].items()):
@@ -350,9 +350,10 @@ def plot_precision(path, r):
         ax.set(title=titles[name], xlabel="CPU per impact [us]", ylabel="relative error")
         ax.title.set_fontsize(10)
         ax.grid(alpha=0.3, which="both")
-    axes[0].legend(fontsize=9)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
     fig.suptitle("Work against precision (gray: 1e-6; ringed: the cheapest setting meeting it)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
 
 
