@@ -1373,9 +1373,9 @@ def write_report(path, study, rows, elapsed, springpot=()):
            "| | " + " | ".join(QUANTITIES) + " |", "|---|" + "---|" * len(QUANTITIES),
            "| C2 (SDIRK2, second order) | " + " | ".join(f"{C2[q]:g}" for q in QUANTITIES) + " |",
            "| D1 (G1 law, 3/(8N)) | " + " | ".join(f"{D1[q]:g}" for q in QUANTITIES) + " |",
-           "| K (adaptive, x steps x tolerance) | " + " | ".join(f"{ADAPTIVE_K[q]:g}" for q in QUANTITIES) + " |",
+           "| K (adaptive: x steps x tolerance; derived, not measured: below) | " + " | ".join(f"{ADAPTIVE_K[q]:g}" for q in QUANTITIES) + " |",
            "",
-           "twice the largest constants the convergence study below measures. The G1 law with N = n steps "
+           "C2 and D1 twice the largest constants the convergence study below measures. The G1 law with N = n steps "
            "since onset has the stiffness k (1 + 3/(8n)): a relative error 3 dt/(8 t) at time t, first order. "
            "For the elastic peak force (F_max ~ K^(2/5), n = t_c/(2 dt) at the peak) that predicts 0.4 * 3/(8 * "
            "1/2) = 0.30 (dt/t_c); the study measures 0.27 in the elastic regime, approached from below as dt "
