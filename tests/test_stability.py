@@ -1,10 +1,13 @@
 """The fast subset of the stability matrix (fraccontact/reports/stability.py; the full
 matrix is docs/stability.md): extreme dashpots, foam and steel, 0.1 mm/s to
 30 m/s, 1 g to 1 t, steps from 1 ns to longer than the contact, N = 1e6,
-rest under gravity, a gap, repeated impacts. Every run passes every check
+rest under gravity, a gap, repeated impacts; each with the G1 and the Hertz
+law in fixed steps and "adaptive" (the Hertz law, tolerance 1e-6, the
+case's dt as the cap dt_max). Every run passes every check
 (finite, no tension, 0 <= eps <= 1, momentum, no energy created beyond
 rounding, F <= c v_max, the GSL reference where the step resolves the
-contact) except the known findings listed in stability.KNOWN, which must
+contact; every figure of an adaptive run, within its error control's
+bound) except the known findings listed in stability.KNOWN, which must
 still fail exactly as listed; the h20 convergence study measures the
 constants the reference tolerances use."""
 
@@ -35,11 +38,11 @@ def test_the_fast_subset_is_all_there():
 def test_known_findings_name_real_runs_and_checks():
     names = {name for name, _ in stability.matrix()}
     for (name, law), checks in stability.KNOWN.items():
-        assert name in names and law in ("g1", "hertz"), (name, law)
+        assert name in names and law in stability.LAWS, (name, law)
         assert checks <= set(stability.CHECKS) and checks, checks
 
 
-@pytest.mark.parametrize("law", ["g1", "hertz"])
+@pytest.mark.parametrize("law", stability.LAWS)
 @pytest.mark.parametrize("name, case", CASES, ids=[name for name, _ in CASES])
 def test_case_passes_every_check(name, case, law):
     row = stability.check(SOLVER, case, law, name)
@@ -116,6 +119,71 @@ def test_reference_tolerance_is_the_scheme_error():
     assert math.isclose(hertz, stability.C2["eps"] * h * h + 4 * stability.ROUNDING_ULPS * stability.ULP)
     assert math.isclose(g1 - hertz, stability.D1["eps"] * h)
     assert stability.resolution(dict(case, dt=sc["t_c"] / 100), sc, "eps") == pytest.approx(h)
+
+
+# --- The adaptive variant: its bounds, and its checks can fail.
+
+def test_adaptive_reference_tolerance_is_the_error_control():
+    """K (accepted steps) x tolerance + the reference's error + rounding,
+    whatever dt (the cap) is: not the fixed scheme's C2 (dt/T)^2."""
+    case = dict(stability.BASE, dt=1e-2)
+    floor = 1e-12
+    for q, K in stability.ADAPTIVE_K.items():
+        tol = stability.tolerance(case, stability.ADAPTIVE, q, 8.0, 21, floor)
+        assert math.isclose(tol, K * 21 * stability.ADAPTIVE_TOLERANCE + floor + 25 * stability.ROUNDING_ULPS
+                            * stability.ULP)
+
+
+@pytest.fixture(scope="module")
+def h20_adaptive():
+    """h20, the adaptive steps capped at 1e-2 (8 contact times): about 20 steps."""
+    case = dict(stability.BASE, dt=1e-2)
+    sc = stability.scales(case)
+    r, err = stability.solve(SOLVER, case, stability.ADAPTIVE, stability.t_end_of(case, sc["t_c"]))
+    assert r is not None, err
+    assert 10 <= r["steps"] <= 40, r["steps"]  # error-controlled, not 1e-2 steps nor 1e-7 ones
+    return case, r
+
+
+def test_adaptive_run_is_compared_on_every_figure(h20_adaptive):
+    """Capped at 8 t_c, every figure still compared, within a few times the
+    tolerance per step (measured: at most 1.2e-5, E_diss, in 21 steps)."""
+    case, _ = h20_adaptive
+    row = stability.check(SOLVER, case, stability.ADAPTIVE, "dt = 0.01")
+    assert set(row["compared"]) == set(stability.QUANTITIES), row["compared"]
+    assert not row["failures"], row["failures"]
+    assert all(e <= 20 * stability.ADAPTIVE_TOLERANCE for e, _ in row["compared"].values()), row["compared"]
+
+
+def adaptive_failing(case, r):
+    checks, _ = stability.invariants(case, r, stability.ADAPTIVE)
+    return {c for c, why in checks.items() if why}
+
+
+def test_adaptive_energy_allows_the_error_control_and_no_more(h20_adaptive):
+    """The energy check allows ADAPTIVE_ENERGY (steps) x tolerance of the
+    impact's energy for the adaptive steps, not for the fixed ones."""
+    case, r = h20_adaptive
+    assert adaptive_failing(case, r) == set()
+    E = 0.5 * case["m"] * case["v0"] ** 2
+    bound = stability.ADAPTIVE_ENERGY * r["steps"] * stability.ADAPTIVE_TOLERANCE * E
+    for share, fails in ((0.5, False), (1.5, True)):
+        more = copy.deepcopy(r)
+        more["E_diss"] += share * bound - (r["E_diss"] + 0.5 * case["m"] * r["v"] ** 2 - E)  # created: share x bound
+        more["per_impact"][0]["E_diss"] = more["E_diss"]
+        assert (stability.ENERGY in adaptive_failing(case, more)) == fails, share
+        assert stability.ENERGY in failing(case, more)  # the fixed scheme's check: rounding only
+
+
+def test_adaptive_invariants_otherwise_unchanged(h20_adaptive):
+    """Momentum to rounding, eps <= 1, F <= c v_max: no allowance for the
+    adaptive steps."""
+    case, r = h20_adaptive
+    assert stability.invariants(case, dict(r, x2=r["x2"] * (1 + 1e-9)), stability.ADAPTIVE)[0]["momentum"]
+    bad = copy.deepcopy(r)
+    bad["per_impact"][0]["eps"] = 1 + 1e-9
+    assert stability.EPS in adaptive_failing(case, bad)
+    assert stability.FORCE in adaptive_failing(case, dict(r, F_peak=case["c"] * case["v0"] * (1 + 1e-9)))
 
 
 # --- The springpot (damper = 2): its fast subset, its study, and checks that can fail.
