@@ -33,13 +33,14 @@ static const char fmi2_guid[] = FMU_GUID;
 
 #define H20_STEP 1e-5 /* the default experiment: 3 ms in steps of 10 us */
 #define H20_STEPS 300
-#define N_OUT 10
+#define N_OUT 11
 #define GAP0 1e-4   /* a gap before the contact, to see its onset inside a step */
 #define V0 0.626418 /* the default striker: sqrt(2 g 0.020), */
 #define M0 0.7437   /* 0.7437 kg */
 
 static const fmi3ValueReference outputs[N_OUT] = {VR_F, VR_F_avg, VR_F_peak, VR_x, VR_x1,
-                                                  VR_x2, VR_v_striker, VR_E_diss, VR_eps, VR_semi_integral};
+                                                  VR_x2, VR_v_striker, VR_E_diss, VR_eps, VR_semi_integral,
+                                                  VR_F_avg_next};
 
 /* ------------------------------------------------------- what the FMU tells */
 
