@@ -429,7 +429,7 @@ static void predict(fmu_model *fm, double H)
         || (contact_steps_uniformly(cm)
             && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->p.dt_max + 0.5)) != 0))
         return;
-    p->model = *cm;
+    contact_copy(&p->model, cm);
     p->impulse = contact_advance(&p->model, H);
     if (isnan(p->impulse))
         return;
@@ -487,7 +487,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
     if (from_prediction) {
-        *cm = fm->next.model; /* the step F_avg_next announced */
+        contact_copy(cm, &fm->next.model); /* the step F_avg_next announced */
         impulse = fm->next.impulse;
     } else {
         impulse = contact_advance_until(cm, H, stop_at);
