@@ -455,7 +455,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     contact_state before;
     memory_copy memory;
     char why[512];
-    double impulse, part, v_end;
+    double impulse, part, t_start, v_end;
     const fmu_variable *overflow;
     /* the outputs and the coupling's account as they were, for a refusal */
     const double F_avg = fm->F_avg, step_span = fm->step_span, F_avg_next = fm->F_avg_next, owed = fm->owed,
@@ -481,6 +481,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->announced = fm->F_avg_next;
         fm->step_H = H;
     }
+    t_start = cm->s.t;
     v_end = cm->s.v;
     contact_drive(cm, start_velocity(fm, v_end), fm->m, fm->v_slope);
     before = cm->s;
@@ -503,10 +504,13 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     *event = stop && event_since(&before, &cm->s);
     /* The step ran on the FMU's clock, from where the last step ended; the
      * master's, which the glue let differ from it by rounding only, sets
-     * the clock at the communication point. So the master's rounding of
-     * its time changes no result, and the predicted step is the step. */
+     * the clock at the communication point, or carries the time to an
+     * event over to it. So the master's rounding of its time changes no
+     * result, and the predicted step is the step. */
     if (!*event)
         cm->s.t = t + H;
+    else if (t != t_start)
+        cm->s.t = fmin(t + (cm->s.t - t_start), t + H);
     part = *event ? cm->s.t - t : H;
     /* The impulse the contact exerted beyond what F_avg_next announced for
      * this part of the communication step: owed to the striker. */
