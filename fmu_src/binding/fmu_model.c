@@ -33,7 +33,8 @@ struct fmu_model {
     double F_avg_next;    /* (predicted impulse of the next step + owed) / step_H; F before the first step */
     double owed;          /* the contact's impulse so far less what F_avg_next announced over it [N s] */
     double announced;     /* F_avg_next as the communication step began: what the master applies over it */
-    double step_H;        /* the step size requested as it began (FM_CONTINUE goes on with it), and
+    double step_start;    /* where the communication step began, */
+    double step_H;        /* the step size requested then (FM_CONTINUE goes on with both), and
                              the length of the step F_avg_next predicts */
     int64_t predicted;    /* communication steps taken from the prediction, */
     int64_t computed;     /* and computed afresh */
@@ -320,7 +321,7 @@ fm_status fm_start(fmu_model *fm, double t0)
     /* No step length yet to predict over: the force now, the limit of a
      * vanishing step (0 at the start, where the striker has not touched). */
     fm->F_avg_next = fm->model.s.F;
-    fm->owed = fm->announced = fm->step_H = 0.0;
+    fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
     fm->predicted = fm->computed = 0;
     fm->next.valid = 0;
     fm->held = 0;
@@ -455,11 +456,11 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     contact_state before;
     memory_copy memory;
     char why[512];
-    double impulse, part, t_start, v_end;
+    double impulse, part, t_start, end, v_end;
     const fmu_variable *overflow;
     /* the outputs and the coupling's account as they were, for a refusal */
     const double F_avg = fm->F_avg, step_span = fm->step_span, F_avg_next = fm->F_avg_next, owed = fm->owed,
-                 announced = fm->announced, step_H = fm->step_H;
+                 announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
     int from_prediction;
@@ -477,8 +478,9 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
         return FM_OK;
     }
-    if (!resume) { /* a new communication step: what a Jacobi master applies over it, and its length */
+    if (!resume) { /* a new communication step: what a Jacobi master applies over it, where and how long */
         fm->announced = fm->F_avg_next;
+        fm->step_start = t;
         fm->step_H = H;
     }
     t_start = cm->s.t;
@@ -495,6 +497,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     if (isnan(impulse)) {
         fm->announced = announced;
+        fm->step_start = step_start;
         fm->step_H = step_H;
         fm->next.valid = 0;
         return report(fm, FM_ERROR, "logStatusError",
@@ -504,13 +507,15 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     *event = stop && event_since(&before, &cm->s);
     /* The step ran on the FMU's clock, from where the last step ended; the
      * master's, which the glue let differ from it by rounding only, sets
-     * the clock at the communication point, or carries the time to an
-     * event over to it. So the master's rounding of its time changes no
+     * the clock at the communication point (where the step went on after
+     * an event too), or carries the time to an event over to it, never
+     * past that point. So the master's rounding of its time changes no
      * result, and the predicted step is the step. */
+    end = resume ? fm->step_start + fm->step_H : t + H; /* as the master adds them */
     if (!*event)
-        cm->s.t = t + H;
-    else if (t != t_start)
-        cm->s.t = fmin(t + (cm->s.t - t_start), t + H);
+        cm->s.t = end;
+    else
+        cm->s.t = fmin(t == t_start ? cm->s.t : t + (cm->s.t - t_start), end);
     part = *event ? cm->s.t - t : H;
     /* The impulse the contact exerted beyond what F_avg_next announced for
      * this part of the communication step: owed to the striker. */
@@ -536,6 +541,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->F_avg_next = F_avg_next;
         fm->owed = owed;
         fm->announced = announced;
+        fm->step_start = step_start;
         fm->step_H = step_H;
         fm->next.valid = 0; /* a memo: dropping it changes no result */
         *event = 0;
@@ -572,7 +578,7 @@ static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), F(step_span),
-    I(coupling), F(F_avg_next), F(owed), F(announced), F(step_H), L(predicted), L(computed),
+    I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
