@@ -245,7 +245,11 @@ def write(path, results, forced, ref, ref_g, scene, g1):
             "master's `v` less `owed/m`: the velocity the striker has once it has received every impulse, which is "
             "the proxy's own end velocity when no other force acts on the striker. Then the step is the predicted "
             "one, and the FMU takes it as computed (a memo: each step costs one computation, not two; the FMU "
-            "counts both kinds in its `logEvents` message at the end of each impact).", "",
+            "counts both kinds in its `logEvents` message at the end of each impact; a step whose inputs differ "
+            "costs two). In the drop test (scene 1) `F_avg_next` is the FMU's own striker's average force over "
+            "its next step; in the driven scene without a striker mass (m = 0), the average force of the next "
+            "step with `v` held, or continued with the slope the master gave (`fmi2SetRealInputDerivatives`).",
+            "",
             "Errors against the monolithic drop test, F_avg_next connected:", "",
             "| H [s] | our driver: F_peak error | eps error | energy error | libcosim: F_peak error | eps error "
             "| energy error |", "|---|---|---|---|---|---|---|"]
