@@ -17,7 +17,14 @@
  *                                     springpot impact by both memories on N =
  *                                     1e3, 1e4, ... LARGEST_N (default 1e6)
  *                                     steps of one span: CPU, F_peak, eps, the
- *                                     memory's values and the history's heap */
+ *                                     memory's values and the history's heap
+ *   fraccontact-bench anchor K C M V T_END RTOL [REPEATS]
+ *                                     the speed anchor of issue 14 (anchor.h):
+ *                                     one impact by GSL's rk8pd as a user would
+ *                                     script it, its figures, right-hand sides,
+ *                                     steps and CPU per impact (median of
+ *                                     REPEATS runs; default as many as fit in
+ *                                     2 s, at most 2001) */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
@@ -26,6 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "anchor.h"
 #include "contact.h"
 #include "fraccontact.h"
 #include "g1.h"
@@ -343,8 +351,82 @@ static int bench_springpot(double largest)
     return 0;
 }
 
+/* ------------------------------------------------------------ anchor */
+
+/* A figure, or null when the run did not get there. */
+static void print_figure(const char *name, int known, double value)
+{
+    if (known)
+        printf("\"%s\": %.17g, ", name, value);
+    else
+        printf("\"%s\": null, ", name);
+}
+
+static int bench_anchor(const anchor_problem *p, int repeats)
+{
+    anchor_result r, again;
+    double *runs, t0;
+    int i;
+    t0 = cpu_seconds();
+    if (anchor_impact(p, &r) != 0) {
+        fprintf(stderr, "fraccontact-bench: GSL failed at t = %g s\n", r.t);
+        return 1;
+    }
+    if (repeats <= 0)
+        repeats = (int)fmin(2001.0, fmax(1.0, floor(2.0 / fmax(cpu_seconds() - t0, 1e-9))));
+    runs = malloc((size_t)repeats * sizeof *runs);
+    if (!runs)
+        return 1;
+    for (i = 0; i < repeats; i++) {
+        t0 = cpu_seconds();
+        anchor_impact(p, &again);
+        runs[i] = cpu_seconds() - t0;
+        if (again.F_peak != r.F_peak || again.t != r.t || again.v != r.v || again.x2 != r.x2 ||
+            again.evaluations != r.evaluations) {
+            fprintf(stderr, "fraccontact-bench: run %d of the anchor differs from the first\n", i);
+            free(runs);
+            return 1;
+        }
+    }
+    printf("{\"k\": %.17g, \"c\": %.17g, \"m\": %.17g, \"v\": %.17g, \"t_end\": %.17g, \"rtol\": %.17g, "
+           "\"separated\": %s, \"F_peak\": %.17g, ",
+           p->k, p->c, p->m, p->v0, p->t_end, p->rtol, r.separated ? "true" : "false", r.F_peak);
+    print_figure("eps", r.separated, r.eps);
+    print_figure("t_contact", r.separated, r.t_contact);
+    print_figure("x2_end", r.separated, r.x2_end);
+    printf("\"end\": {\"t\": %.17g, \"x1\": %.17g, \"x2\": %.17g, \"v\": %.17g, \"F\": %.17g}, "
+           "\"rhs_evaluations\": %ld, \"steps\": %ld, \"rejected_steps\": %ld, \"us_per_impact\": %.4g, "
+           "\"repeats\": %d}\n",
+           r.t, r.x1, r.x2, r.v, r.F, r.evaluations, r.steps, r.rejected, median(runs, repeats) * 1e6, repeats);
+    free(runs);
+    return 0;
+}
+
+/* The anchor's arguments K C M V T_END RTOL, all positive; 0 when they are. */
+static int anchor_arguments(char **argv, anchor_problem *p)
+{
+    double *fields[6];
+    int i;
+    fields[0] = &p->k;
+    fields[1] = &p->c;
+    fields[2] = &p->m;
+    fields[3] = &p->v0;
+    fields[4] = &p->t_end;
+    fields[5] = &p->rtol;
+    for (i = 0; i < 6; i++) {
+        char *end;
+        *fields[i] = strtod(argv[i], &end);
+        if (end == argv[i] || *end != '\0' || !(*fields[i] > 0.0) || !isfinite(*fields[i])) {
+            fprintf(stderr, "fraccontact-bench anchor: '%s' is not a positive number\n", argv[i]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    anchor_problem anchor;
     if (argc == 5 && strcmp(argv[1], "batch") == 0 && atol(argv[2]) > 0)
         return bench_batch((size_t)atol(argv[2]), atoi(argv[3]), atof(argv[4]));
     if (argc == 2 && strcmp(argv[1], "step") == 0)
@@ -353,6 +435,9 @@ int main(int argc, char **argv)
         return bench_g1((size_t)atol(argv[2]), atof(argv[3]));
     if ((argc == 2 || (argc == 3 && atof(argv[2]) >= 1e3)) && strcmp(argv[1], "springpot") == 0)
         return bench_springpot(argc == 3 ? atof(argv[2]) : 1e6);
-    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX | springpot [LARGEST_N]\n");
+    if ((argc == 8 || argc == 9) && strcmp(argv[1], "anchor") == 0)
+        return anchor_arguments(argv + 2, &anchor) != 0 ? 2 : bench_anchor(&anchor, argc == 9 ? atoi(argv[8]) : 0);
+    fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX | springpot [LARGEST_N] | "
+                    "anchor K C M V T_END RTOL [REPEATS]\n");
     return 2;
 }

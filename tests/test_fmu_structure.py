@@ -23,6 +23,8 @@ def perturbed(v):
     start = float(v.start)
     if v.name == "memory_tolerance":
         return start * 10.0
+    if v.name == "tolerance":
+        return 1e-6
     return start * 1.5 + 0.1 if v.name not in ("nu_i", "nu_s") else start * 0.5
 
 

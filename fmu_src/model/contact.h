@@ -141,6 +141,9 @@ typedef struct {
     double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
+    int error_controlled;   /* tolerance > 0 where it applies: error-controlled steps */
+    double root_precision;  /* relative accuracy an implicit stage's root needs (0: to rounding) */
+    double peak_force_seen, peak_length; /* error control's cache: a force and its elastic indentation */
     contact_state s;
     contact_modes modes;      /* a springpot's compressed memory */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
@@ -166,7 +169,9 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
  * parameter (R, E_i, nu_i, E_s, nu_s) differs from its default (k wins), or
  * a damper's parameter changed while the other damper is selected (c with
  * the springpot; damper_order, c_alpha, memory, memory_tolerance with the
- * dashpot; memory_tolerance with the full G1 history). Returns 1 and the
+ * dashpot; memory_tolerance with the full G1 history), or tolerance > 0
+ * where steps stay fixed (the G1 laws with g1_nodes = 0, the central
+ * scheme, the springpot). Returns 1 and the
  * message naming such parameters, or 0. */
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
