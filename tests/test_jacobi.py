@@ -371,3 +371,17 @@ def test_early_return_under_a_jacobi_master():
     assert F_peak == pytest.approx(own["F_peak"][-1], rel=ROUNDING, abs=0)
     assert eps == pytest.approx(own["eps"][-1], rel=ROUNDING, abs=0)
     assert v == pytest.approx(own["v_striker"][-1], rel=ROUNDING, abs=0)
+
+
+def test_error_controlled_steps_under_a_jacobi_master(slave):
+    """tolerance > 0 (error-controlled internal steps, whose next length is
+    part of the state): the predicted step is still the step, and the Jacobi
+    coupling is the FMU's own drop test at the same tolerance, to rounding
+    (the same internal steps; measured 1.5e-14)."""
+    r = jacobi(slave, 1e-4, tolerance=1e-6)
+    s = slave(law=2, tolerance=1e-6)
+    for _ in range(30):
+        s.step(1e-4)
+    assert r["F_peak"] == pytest.approx(s.get("F_peak"), rel=ROUNDING, abs=0)
+    assert -r["v_end"] / V0 == pytest.approx(s.get("eps"), rel=ROUNDING, abs=0)
+    assert r["counts"] == (13, 1)
