@@ -69,8 +69,8 @@ static void intermediate_update(fmi3InstanceEnvironment env, fmi3Float64 time, f
     *early_return_time = time;
 }
 
-#define N_OUT 10
-static const fmi3ValueReference outputs[N_OUT] = {13, 14, 15, 16, 17, 18, 19, 20, 21, 22};
+#define N_OUT 11
+static const fmi3ValueReference outputs[N_OUT] = {13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 28};
 
 /* Every real output, when readable, is finite and the force is not tension. */
 static void check_outputs(fmi3Instance c)

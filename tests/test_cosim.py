@@ -48,7 +48,7 @@ def test_jacobi_lags_by_one_step(reference):
     assert 8 < e10 / e1 < 12
 
 
-@pytest.mark.parametrize("coupling", ["zoh", "mass-aware"])
+@pytest.mark.parametrize("coupling", ["zoh", "mass-aware", "predictive"])
 def test_libcosim_runs_the_scene_as_our_jacobi_master_does(coupling):
     """libcosim (OSP, via libcosimpy) steps both FMUs from the last values:
     its results are our driver's Jacobi results."""

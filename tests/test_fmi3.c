@@ -33,13 +33,14 @@ static const char fmi2_guid[] = FMU_GUID;
 
 #define H20_STEP 1e-5 /* the default experiment: 3 ms in steps of 10 us */
 #define H20_STEPS 300
-#define N_OUT 10
+#define N_OUT 11
 #define GAP0 1e-4   /* a gap before the contact, to see its onset inside a step */
 #define V0 0.626418 /* the default striker: sqrt(2 g 0.020), */
 #define M0 0.7437   /* 0.7437 kg */
 
 static const fmi3ValueReference outputs[N_OUT] = {VR_F, VR_F_avg, VR_F_peak, VR_x, VR_x1,
-                                                  VR_x2, VR_v_striker, VR_E_diss, VR_eps, VR_semi_integral};
+                                                  VR_x2, VR_v_striker, VR_E_diss, VR_eps, VR_semi_integral,
+                                                  VR_F_avg_next};
 
 /* ------------------------------------------------------- what the FMU tells */
 
@@ -751,6 +752,81 @@ static void test_intermediate_update(void)
     CHECK(rec.wrong_environment == 0, "the callback gets the instance environment");
 }
 
+/* ------------------------------------------------- the Jacobi coupling */
+
+/* The drop test from GAP0 in the driven scene under a Jacobi master with
+ * the coupling for it (coupling = 2): the master's striker (integrated here,
+ * the force held over each step, exact) receives F_avg_next, read before
+ * the step, over the part of the step the FMU took; with early return it
+ * goes on from lastSuccessfulTime. r.impulse: what the striker received. */
+static run_result jacobi_from_gap(fmi3Boolean early_return, fmi3IntermediateUpdateCallback update)
+{
+    fmi3Instance c = instantiate("jacobi", fmi3False, early_return, update);
+    const fmi3ValueReference ints[2] = {VR_scene, VR_coupling};
+    const fmi3Int32 values[2] = {2, 2};
+    run_result r = {-1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0, 0};
+    double t = 0.0, v = V0;
+    int i;
+    CHECK(set(c, VR_gap0, GAP0) == fmi3OK && fmi3SetInt32(c, ints, 2, values, 2) == fmi3OK, "driven, coupling 2: %s",
+          rec.message);
+    start(c);
+    for (i = 0; i < H20_STEPS; i++) {
+        const double end = (i + 1) * H20_STEP;
+        while (t < end) {
+            const double F_next = get(c, VR_F_avg_next);
+            step_result s;
+            set(c, VR_v, v);
+            s = step(c, t, end - t);
+            r.steps++;
+            CHECK(s.status == fmi3OK, "step at %.17g: %s", t, rec.message);
+            if (s.status != fmi3OK)
+                break;
+            r.early_returns += s.early;
+            v -= F_next * (s.last - t) / M0;
+            r.impulse += F_next * (s.last - t);
+            t = s.last;
+        }
+        t = end;
+    }
+    r.F_peak = get(c, VR_F_peak);
+    r.eps = get(c, VR_eps);
+    r.v_end = v;
+    CHECK_REL(v, get(c, VR_v_striker), rounding_tolerance(1e4), "the master's striker ends as the proxy");
+    fmi3FreeInstance(c);
+    return r;
+}
+
+/* F_avg_next under every way FMI 3.0 steps: whole steps, the intermediate
+ * update at both events inside a step that goes on (the force the master
+ * applies over the step is the one read before it), and early return at
+ * both (the master applies it up to lastSuccessfulTime): each is the FMU's
+ * own drop test, to the rounding of splitting steps at the events. */
+static void test_jacobi_coupling(void)
+{
+    run_result own = drop_from_gap(fmi3False, fmi3False, NULL), runs[3];
+    const char *names[3] = {"whole steps", "intermediate update", "early return"};
+    double tol = rounding_tolerance(1.4e-3 / 1e-7);
+    int k;
+    memset(&rec, 0, sizeof rec);
+    runs[0] = jacobi_from_gap(fmi3False, NULL);
+    runs[1] = jacobi_from_gap(fmi3False, intermediate_update);
+    CHECK(rec.updates == 2, "the intermediate update at onset and separation: %d", rec.updates);
+    runs[2] = jacobi_from_gap(fmi3True, NULL);
+    CHECK(runs[0].early_returns == 0 && runs[1].early_returns == 0 && runs[2].early_returns == 2,
+          "early returns: %d, %d, %d", runs[0].early_returns, runs[1].early_returns, runs[2].early_returns);
+    for (k = 0; k < 3; k++) {
+        char what[4][96];
+        snprintf(what[0], sizeof what[0], "Jacobi, %s: F_peak", names[k]);
+        snprintf(what[1], sizeof what[1], "Jacobi, %s: eps", names[k]);
+        snprintf(what[2], sizeof what[2], "Jacobi, %s: the master's striker rebounds", names[k]);
+        snprintf(what[3], sizeof what[3], "Jacobi, %s: the impulse received is the momentum", names[k]);
+        CHECK_REL(runs[k].F_peak, own.F_peak, tol, what[0]);
+        CHECK_REL(runs[k].eps, own.eps, tol, what[1]);
+        CHECK_REL(-runs[k].v_end, own.eps * V0, tol, what[2]);
+        CHECK_REL(runs[k].impulse, M0 * (V0 - runs[k].v_end), rounding_tolerance(H20_STEPS), what[3]);
+    }
+}
+
 /* ------------------------------------------------------------- FMU state */
 
 static size_t state_bytes(fmi3Instance c, fmi3FMUState state, fmi3Byte *bytes, size_t capacity)
@@ -1133,6 +1209,7 @@ int main(int argc, char **argv)
     test_early_return();
     test_event_details();
     test_intermediate_update();
+    test_jacobi_coupling();
     test_fmu_state();
     test_logging();
     test_unsupported();

@@ -90,19 +90,21 @@ def test_every_variable_is_read_or_written(slave, model_description):
     """Each parameter and input takes a value and reads it back; each output
     is read after an impact and obeys a relation it must."""
     # A cone-like spring (n = 2); the springpot's parameters are set and read
-    # back here but act only with damper = 2 (test_springpot.py).
+    # back here but act only with damper = 2 (test_springpot.py), coupling
+    # only in the driven scene (test_jacobi.py).
     values = dict(R=5e-3, E_i=200e9, nu_i=0.29, E_s=2.5e9, nu_s=0.41, k=3.1e8, c=5000.0, dt_max=5e-8,
                   g=0.0, gap0=1e-5, v=0.5, m=0.6, law=2, g1_nodes=0, scene=1, spring_exponent=2.0, damper=1,
-                  damper_order=0.7, c_alpha=1e5, memory=1, memory_tolerance=1e-8, tolerance=1e-6)
+                  damper_order=0.7, c_alpha=1e5, memory=1, memory_tolerance=1e-8, tolerance=1e-6, coupling=1)
     names = {v.name for v in model_description.modelVariables}
     outputs = {v.name for v in model_description.modelVariables if v.causality == "output"}
     assert set(values) | outputs == names, "a variable is neither set nor read here"
     s = slave(**values)
     for name, value in values.items():
         assert s.get(name) == value, name
-    total_impulse = 0.0
+    total_impulse = announced = 0.0
     H = 1e-5
     while s.get("eps") == 0.0:
+        announced += s.get("F_avg_next") * H  # what a Jacobi master applies over the step
         s.step(H)
         total_impulse += s.get("F_avg") * H
         F, F_peak = s.get("F"), s.get("F_peak")
@@ -120,5 +122,10 @@ def test_every_variable_is_read_or_written(slave, model_description):
     # a sum of ~130 steps' F_avg H, rounding bound n eps = 3e-14 (measured
     # 1.6e-15).
     assert total_impulse == pytest.approx(0.6 * (0.5 - s.get("v_striker")), rel=3e-14, abs=0)
+    # F_avg_next announces each step's impulse one step ahead, and the impulse
+    # it could not announce (the first step's, before which it is F = 0) a
+    # step late: with the last F_avg_next, whose predicted step is free
+    # flight after the separation, it has announced every impulse (n eps).
+    assert announced + s.get("F_avg_next") * H == pytest.approx(total_impulse, rel=3e-14, abs=0)
     # eps = -v_end / v_onset, and v_onset = v = 0.5 (no gravity): one division
     assert s.get("eps") == pytest.approx(-s.get("v_striker") / 0.5, rel=EPS, abs=0)

@@ -10,7 +10,7 @@ import textwrap
 import pytest
 from fmpy.fmi1 import FMICallException
 
-OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
+OUTPUTS = ["F", "F_avg", "F_avg_next", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
 H = 1e-5
 
 

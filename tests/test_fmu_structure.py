@@ -19,7 +19,7 @@ def knowns(md):
 def perturbed(v):
     """A different valid value for the known."""
     if v.type == "Integer":
-        return {"law": 2, "g1_nodes": 5, "scene": 2, "damper": 2, "memory": 1}[v.name]
+        return {"law": 2, "g1_nodes": 5, "scene": 2, "damper": 2, "memory": 1, "coupling": 2}[v.name]
     start = float(v.start)
     if v.name == "memory_tolerance":
         return start * 10.0

@@ -10,17 +10,40 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The model advanced by one more communication step from the end of the
+ * last, computed with F_avg_next: the next step itself when its inputs come
+ * as assumed (a memo of a deterministic computation, so that dropping it
+ * changes no result; not part of the FMU state). A full G1 history's buffer
+ * is shared with the model, room for the step reserved first. */
+typedef struct {
+    int valid;
+    double H;             /* the step's length */
+    double impulse;       /* the contact force's impulse over it */
+    int event;            /* an onset or a separation inside it */
+    contact_model model;  /* the state at its end */
+} prediction;
+
 struct fmu_model {
     contact_params params;
+    int coupling;         /* enum fmu_coupling */
     double v, m;          /* the inputs as last set */
     double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
     double F_avg;         /* impulse of the last communication step / its length */
     double step_span;     /* that length: where an early return cut it, so far */
+    double F_avg_next;    /* (predicted impulse of the next step + owed) / step_H; F before the first step */
+    double owed;          /* the contact's impulse so far less what F_avg_next announced over it [N s] */
+    double announced;     /* F_avg_next as the communication step began: what the master applies over it */
+    double step_start;    /* where the communication step began, */
+    double step_H;        /* the step size requested then (FM_CONTINUE goes on with both), and
+                             the length of the step F_avg_next predicts */
+    int64_t predicted;    /* communication steps taken from the prediction, */
+    int64_t computed;     /* and computed afresh */
     int started;          /* past initialization: fixed parameters are frozen */
     int held;             /* a step stopped at an event: the discrete outputs show */
     int held_contact;     /* their values from before it until fm_update_discrete */
     double held_eps;
     contact_model model;
+    prediction next;
     fmu_reporter log;
 };
 
@@ -46,6 +69,7 @@ static const fmu_variable variable_list[] = {
     {VR_gap0, "gap0", VAR_REAL, VAR_PARAMETER, PARAM(gap0)},
     {VR_F, "F", VAR_REAL, VAR_OUTPUT, 0},
     {VR_F_avg, "F_avg", VAR_REAL, VAR_OUTPUT, 0},
+    {VR_F_avg_next, "F_avg_next", VAR_REAL, VAR_OUTPUT, 0},
     {VR_F_peak, "F_peak", VAR_REAL, VAR_OUTPUT, 0},
     {VR_x, "x", VAR_REAL, VAR_OUTPUT, 0},
     {VR_x1, "x1", VAR_REAL, VAR_OUTPUT, 0},
@@ -59,6 +83,7 @@ static const fmu_variable variable_list[] = {
     {VR_scene, "scene", VAR_INTEGER, VAR_PARAMETER, PARAM(scene)},
     {VR_damper, "damper", VAR_INTEGER, VAR_PARAMETER, PARAM(damper)},
     {VR_memory, "memory", VAR_INTEGER, VAR_PARAMETER, PARAM(memory)},
+    {VR_coupling, "coupling", VAR_INTEGER, VAR_PARAMETER, offsetof(fmu_model, coupling)},
     {VR_contact, "contact", VAR_BOOLEAN, VAR_OUTPUT, 0},
 };
 
@@ -66,13 +91,27 @@ static const fmu_variables variables = {variable_list, sizeof variable_list / si
 
 #define report(fm, ...) fmu_say(&(fm)->log, __VA_ARGS__)
 
+/* 0 when the binding's own parameter is usable, else -1 and why. */
+static int check_coupling(int coupling, char *why, size_t len)
+{
+    if (coupling == COUPLING_GAUSS_SEIDEL || coupling == COUPLING_JACOBI)
+        return 0;
+    return contact_reject(why, len, "coupling", coupling,
+                          "1 = the master feeds F_avg to the striker after this step (Gauss-Seidel), "
+                          "2 = F_avg_next before it (Jacobi)");
+}
+
 /* Applies a parameter change only if the parameters stay valid. */
 static fm_status set_parameter(fmu_model *fm, const fmu_variable *var, const void *value, size_t size)
 {
-    fmu_model trial = *fm;
+    contact_params params = fm->params;
+    int coupling = fm->coupling;
     char why[256];
-    memcpy((char *)&trial + var->offset, value, size);
-    if (contact_check_params(&trial.params, why, sizeof why) != 0)
+    if (var->offset == offsetof(fmu_model, coupling))
+        memcpy(&coupling, value, size);
+    else
+        memcpy((char *)&params + (var->offset - offsetof(fmu_model, params)), value, size);
+    if (contact_check_params(&params, why, sizeof why) != 0 || check_coupling(coupling, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     memcpy((char *)fm + var->offset, value, size);
     return FM_OK;
@@ -123,6 +162,7 @@ void fm_reset(fmu_model *fm)
     fm->log = log;
     contact_default_params(&fm->params);
     contact_default_striker(&fm->v, &fm->m);
+    fm->coupling = COUPLING_GAUSS_SEIDEL;
     preview_start(fm);
 }
 
@@ -151,6 +191,7 @@ static double real_output(const fmu_model *fm, unsigned vr)
     switch (vr) {
     case VR_F: return cm->s.F;
     case VR_F_avg: return fm->F_avg;
+    case VR_F_avg_next: return fm->started ? fm->F_avg_next : cm->s.F;
     case VR_F_peak: return cm->s.F_peak;
     case VR_x: return contact_total_indentation(cm);
     case VR_x1: return contact_elastic_indentation(cm);
@@ -277,10 +318,20 @@ fm_status fm_start(fmu_model *fm, double t0)
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
     fm->step_span = 0.0;
+    /* No step length yet to predict over: the force now, the limit of a
+     * vanishing step (0 at the start, where the striker has not touched). */
+    fm->F_avg_next = fm->model.s.F;
+    fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
+    fm->predicted = fm->computed = 0;
+    fm->next.valid = 0;
     fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
+    if (fm->coupling != COUPLING_GAUSS_SEIDEL && fm->params.scene == CONTACT_SCENE_DROP)
+        return report(fm, FM_WARNING, "logStatusWarning",
+                      "coupling = %d has no effect in the drop test (scene = 1): the FMU's striker is its own",
+                      fm->coupling);
     return FM_OK;
 }
 
@@ -311,8 +362,10 @@ static void report_events(fmu_model *fm, const contact_state *before)
 {
     const contact_state *s = &fm->model.s;
     if (s->impacts != before->impacts)
-        report(fm, FM_OK, "logEvents", "impact %" PRId64 " ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N",
-               s->impacts, s->t, s->eps, s->x2, s->F_peak);
+        report(fm, FM_OK, "logEvents",
+               "impact %" PRId64 " ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N; "
+               "communication steps so far: %" PRId64 " taken from the prediction, %" PRId64 " computed",
+               s->impacts, s->t, s->eps, s->x2, s->F_peak, fm->predicted, fm->computed);
     if (s->in_contact && (!before->in_contact || s->impacts != before->impacts))
         report(fm, FM_OK, "logEvents", "contact began in (%.9g, %.9g] s at %.6g m/s",
                before->t, s->t, s->v_onset);
@@ -335,15 +388,82 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     return fm_do_step_until(fm, t, H, 0u, &event);
 }
 
+/* A proxy striker's velocity from the master's before a step follows the
+ * proxy's own end velocity from the last step when the two differ by no
+ * more than this fraction of the velocities at hand: two integrations of
+ * the same motion (the proxy's internal steps, the master's striker) differ
+ * by rounding, which grows with the steps taken. Any larger difference is
+ * a force on the striker the proxy did not know (gravity the FMU's g lacks,
+ * a spring), and the master's velocity wins. Since the comparison is made
+ * afresh each step against the master's velocity, the velocity the proxy
+ * ignores never exceeds this fraction. */
+#define SAME_MOTION 1e-12
+
+/* The velocity the step starts from. The master's v, except for a proxy
+ * striker (driven scene, m > 0): with the Jacobi coupling less the impulse
+ * owed (the striker has not yet received it), and its own end velocity
+ * v_end when the master's agrees with it to rounding (SAME_MOTION). A
+ * deterministic function of the state and the inputs, so that a memo of
+ * the step (the prediction) may be dropped without changing a result. */
+static double start_velocity(const fmu_model *fm, double v_end)
+{
+    double v = fm->v;
+    if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->m > 0.0))
+        return v;
+    if (fm->coupling == COUPLING_JACOBI)
+        v -= fm->owed / fm->m;
+    return fabs(v - v_end) <= SAME_MOTION * fmax(fmax(fabs(v), fabs(v_end)), fabs(fm->model.s.v_onset)) ? v_end : v;
+}
+
+/* The next step, of length H from the model's state as the last step left
+ * it, into fm->next (valid = 0 where it cannot be taken: the full G1
+ * history's grid or its limit, memory for it, or a non-finite state). */
+static void predict(fmu_model *fm, double H)
+{
+    prediction *p = &fm->next;
+    contact_model *cm = &fm->model;
+    char why[512];
+    p->valid = 0;
+    /* The full G1 history's struct copy shares its buffer: room for the
+     * predicted steps first, so that the copy never reallocates it. */
+    if (contact_check_advance(cm, H, why, sizeof why) != 0
+        || (contact_steps_uniformly(cm)
+            && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->p.dt_max + 0.5)) != 0))
+        return;
+    contact_copy(&p->model, cm);
+    p->impulse = contact_advance(&p->model, H);
+    if (isnan(p->impulse))
+        return;
+    p->H = H;
+    p->event = event_since(&cm->s, &p->model.s);
+    p->valid = 1;
+}
+
+/* Whether the step of length H (stopping at the events of stop_at), its
+ * inputs applied to the model, is the one predicted: the same velocity,
+ * drive and length, and no event inside when it must stop at one. */
+static int predicted_step(const fmu_model *fm, double H, unsigned stop_at, double v_end)
+{
+    const prediction *p = &fm->next;
+    const contact_model *cm = &fm->model;
+    return p->valid && H == p->H && cm->s.v == v_end && cm->inv_m == p->model.inv_m && cm->accel == p->model.accel
+           && !(stop_at && p->event);
+}
+
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
 {
     contact_model *cm = &fm->model;
     contact_state before;
     memory_copy memory;
     char why[512];
-    double impulse, span, F_avg = fm->F_avg, step_span = fm->step_span;
+    double impulse, part, t_start, end, v_end;
     const fmu_variable *overflow;
+    /* the outputs and the coupling's account as they were, for a refusal */
+    const double F_avg = fm->F_avg, step_span = fm->step_span, F_avg_next = fm->F_avg_next, owed = fm->owed,
+                 announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
+    const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
+    int from_prediction;
     *event = 0;
     /* A refused step changes nothing, so the checks come first. About a
      * minute of CPU: beyond that a step is a mistake, not a wish. */
@@ -354,25 +474,63 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     if (H > 0.0 && contact_check_advance(cm, H, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
     fm_update_discrete(fm); /* a new step: the master has seen the last event */
-    cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
-    if (H == 0.0)
+    if (H == 0.0) {
+        cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
         return FM_OK;
-    contact_drive(cm, fm->v, fm->m, fm->v_slope);
+    }
+    if (!resume) { /* a new communication step: what a Jacobi master applies over it, where and how long */
+        fm->announced = fm->F_avg_next;
+        fm->step_start = t;
+        fm->step_H = H;
+    }
+    t_start = cm->s.t;
+    v_end = cm->s.v;
+    contact_drive(cm, start_velocity(fm, v_end), fm->m, fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
-    impulse = contact_advance_until(cm, H, stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u);
-    if (isnan(impulse))
+    from_prediction = predicted_step(fm, H, stop_at, v_end);
+    if (from_prediction) {
+        contact_copy(cm, &fm->next.model); /* the step F_avg_next announced */
+        impulse = fm->next.impulse;
+    } else {
+        impulse = contact_advance_until(cm, H, stop_at);
+    }
+    if (isnan(impulse)) {
+        fm->announced = announced;
+        fm->step_start = step_start;
+        fm->step_H = step_H;
+        fm->next.valid = 0;
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: the state became non-finite in [%.17g, %.17g] s; "
                       "it is kept at the start of the step", t, t + H);
-    *event = stop && event_since(&before, &cm->s);
-    span = *event ? cm->s.t - t : H;
-    if (resume) { /* the average over the whole communication step so far */
-        impulse += F_avg * step_span;
-        span += step_span;
     }
-    fm->F_avg = span > 0.0 ? impulse / span : cm->s.F;
-    fm->step_span = span;
+    *event = stop && event_since(&before, &cm->s);
+    /* The step ran on the FMU's clock, from where the last step ended; the
+     * master's, which the glue let differ from it by rounding only, sets
+     * the clock at the communication point (where the step went on after
+     * an event too), or carries the time to an event over to it, never
+     * past that point. So the master's rounding of its time changes no
+     * result, and the predicted step is the step. */
+    end = resume ? fm->step_start + fm->step_H : t + H; /* as the master adds them */
+    if (!*event)
+        cm->s.t = end;
+    else
+        cm->s.t = fmin(t == t_start ? cm->s.t : t + (cm->s.t - t_start), end);
+    part = *event ? cm->s.t - t : H;
+    /* The impulse the contact exerted beyond what F_avg_next announced for
+     * this part of the communication step: owed to the striker. */
+    fm->owed += impulse - fm->announced * part;
+    if (resume) { /* the average over the whole communication step so far */
+        impulse += fm->F_avg * fm->step_span;
+        part += fm->step_span;
+    }
+    fm->F_avg = part > 0.0 ? impulse / part : cm->s.F;
+    fm->step_span = part;
+    /* The next communication step, as long as this one was requested, from
+     * wherever this one ended; without a prediction the average force of
+     * this step, held. */
+    predict(fm, fm->step_H);
+    fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
     overflow = nonfinite_output(fm);
     if (overflow) {
         double value = real_output(fm, overflow->vr);
@@ -380,11 +538,21 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         restore_memory(cm, &memory);
         fm->F_avg = F_avg;
         fm->step_span = step_span;
+        fm->F_avg_next = F_avg_next;
+        fm->owed = owed;
+        fm->announced = announced;
+        fm->step_start = step_start;
+        fm->step_H = step_H;
+        fm->next.valid = 0; /* a memo: dropping it changes no result */
         *event = 0;
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
                       "the state is kept at the start of the step", overflow->name, value, t, t + H);
     }
+    if (from_prediction)
+        fm->predicted++;
+    else
+        fm->computed++;
     if (*event) {
         fm->held = 1;
         fm->held_contact = before.in_contact;
@@ -410,6 +578,7 @@ static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), F(step_span),
+    I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
@@ -480,13 +649,15 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     if (problem)
         return report(fm, FM_ERROR, "logStatusError", "%s", problem);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
-        || contact_check_striker(&trial.params, CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0)
+        || contact_check_striker(&trial.params, CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0
+        || check_coupling(trial.coupling, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
         || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
         || !(trial.model.s.F >= 0.0 && trial.model.s.F <= trial.model.s.F_peak)
-        || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0)
+        || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0
+        || trial.step_H < 0.0 || trial.step_span < 0.0 || trial.predicted < 0 || trial.computed < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
     for (i = 0; i < count; i++)
         if (!isfinite(serial_get_double(memory + 8 * i)))
@@ -505,5 +676,6 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     for (i = 0; i < count; i++)
         contact_memory_set(&trial.model, i, serial_get_double(memory + 8 * i));
     *fm = trial;
+    fm->next.valid = 0; /* a memo of the next step: the next step computes it again, to the bit */
     return FM_OK;
 }

@@ -1491,3 +1491,26 @@ void contact_memory_set(contact_model *cm, size_t i, double value)
     else
         cm->history.x2[i - 3] = value;
 }
+
+void contact_copy(contact_model *to, const contact_model *from)
+{
+    const contact_modes *f = &from->modes;
+    contact_modes *t = &to->modes;
+    const size_t bytes = f->modes * sizeof f->a[0];
+    /* all but the modes, then the modes' scalars and the used part of each array */
+    memcpy(to, from, offsetof(contact_model, modes));
+    to->history = from->history;
+    t->modes = f->modes;
+    t->eta = f->eta;
+    t->h = f->h;
+    t->sum_p = f->sum_p;
+    t->sum_q = f->sum_q;
+    memcpy(t->a, f->a, bytes);
+    memcpy(t->b, f->b, bytes);
+    memcpy(t->phi, f->phi, bytes);
+    memcpy(t->p, f->p, bytes);
+    memcpy(t->q, f->q, bytes);
+    memcpy(t->keep, f->keep, bytes);
+    memcpy(t->rate1, f->rate1, bytes);
+    memcpy(t->rate2, f->rate2, bytes);
+}

@@ -120,7 +120,7 @@ typedef struct {
     double sum_p, sum_q;          /* sum_i p_i, sum_i q_i */
     double p[CONTACT_MAX_MODES], q[CONTACT_MAX_MODES];      /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
     double keep[CONTACT_MAX_MODES], rate1[CONTACT_MAX_MODES], rate2[CONTACT_MAX_MODES]; /* the update */
-} contact_modes;
+} contact_modes; /* a new field: copy it in contact_copy too */
 
 /* The full G1 history (a springpot with memory = 1): x2 at every step since
  * t = 0 and the G1 weights, grown geometrically. */
@@ -194,6 +194,11 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
  * springpot with memory = 1 steps); the model may start again. A struct copy
  * of such a model shares the buffer: never advance both. */
 void contact_release(contact_model *cm);
+
+/* *to = *from, the compressed memory's arrays only as far as they hold
+ * modes (a dashpot's model is a twentieth of the struct): for a caller that
+ * copies a model at every step. The same sharing of a G1 history. */
+void contact_copy(contact_model *to, const contact_model *from);
 
 /* The springpot's memory beside the state, as `count` values for saving and
  * restoring it: the damper's rate x2' first, then the compressed modes'

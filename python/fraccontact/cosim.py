@@ -7,13 +7,20 @@ Couplings:
               and the striker holds the contact force F of the last point;
   mass-aware  the contact runs a proxy striker of the same mass inside the
               step (m > 0) and the striker receives F_avg, the step's
-              impulse divided by its length.
+              impulse divided by its length;
+  predictive  the proxy striker as above, and the striker receives
+              F_avg_next, the average force the contact predicts for the
+              next step (coupling = 2): for Jacobi masters only.
 Orders:
   jacobi        both FMUs step from the values of the last point;
   gauss-seidel  the contact steps first, the striker then takes its force.
 
+An external force on the striker: gravity g (the striker FMU's parameter),
+which the contact FMU's proxy knows only when given g_contact = g.
+
 Used by the cosim_study report and tests/test_cosim.py; also a command:
   fraccontact cosim --step 1e-4 --coupling mass-aware --order gauss-seidel
+  fraccontact cosim --step 1e-4 --coupling predictive --order libcosim
 """
 
 import argparse
@@ -26,8 +33,34 @@ from . import fmu_path, model
 from .fmu import Slave, unpacked
 
 M, V0 = model.defaults()["m"], model.defaults()["v"]  # the h20 drop test's striker
-COUPLINGS = ("zoh", "mass-aware")
+COUPLINGS = ("zoh", "mass-aware", "predictive")
 ORDERS = ("jacobi", "gauss-seidel")
+# What each coupling connects to the striker's force, and the contact's
+# settings for it: its proxy striker's mass and its parameter coupling.
+FORCE = {"zoh": "F", "mass-aware": "F_avg", "predictive": "F_avg_next"}
+
+
+def contact_values(coupling, g_contact=0.0):
+    """The contact FMU's values for a coupling: driven, closed-form Hertz,
+    the striker's mass (not with zoh) and, for F_avg_next, coupling = 2."""
+    values = {"law": 2, "scene": 2, "v": V0, "m": 0.0 if coupling == "zoh" else M, "g": g_contact}
+    if coupling == "predictive":
+        values["coupling"] = 2
+    return values
+
+
+def check_order(coupling, order):
+    """F_avg_next is the force of the next step: a Gauss-Seidel master, which
+    applies the force of the step just taken, connects F_avg instead."""
+    if coupling == "predictive" and order == "gauss-seidel":
+        raise ValueError("the predictive coupling (F_avg_next) is for Jacobi masters: "
+                         "a Gauss-Seidel master connects F_avg (mass-aware)")
+
+
+def energy_error(v_end, E_diss, x_end=0.0, g=0.0):
+    """(kinetic energy at the end + the work dissipated - gravity's work on
+    the striker) over the impact energy, less 1: > 0 is energy created."""
+    return (0.5 * M * v_end ** 2 + E_diss - M * g * x_end) / (0.5 * M * V0 ** 2) - 1
 
 
 class Unit(Slave):
@@ -46,28 +79,30 @@ class Unit(Slave):
         return values[0] if len(names) == 1 else values
 
 
-def monolithic(contact_fmu, t_end=3e-3, H=1e-5, law=2):
+def monolithic(contact_fmu, t_end=3e-3, H=1e-5, law=2, g=0.0):
     """The reference: the contact FMU's own drop test, same model and dt_max
-    (the closed-form Hertz law unless law says otherwise)."""
-    c = Unit(contact_fmu, "monolithic", {"law": law, "v": V0, "m": M})
+    (the closed-form Hertz law unless law says otherwise), its striker under
+    the acceleration g; v_end is its velocity at t_end."""
+    c = Unit(contact_fmu, "monolithic", {"law": law, "v": V0, "m": M, "g": g})
     t = 0.0
     while t < t_end - 1e-15:
         c.fmu.doStep(t, H)
         t += H
-    F_peak, eps, E_diss, v = c.get("F_peak", "eps", "E_diss", "v_striker")
+    F_peak, eps, E_diss, v, x = c.get("F_peak", "eps", "E_diss", "v_striker", "x")
     c.free()
-    return dict(F_peak=F_peak, eps=eps, E_diss=E_diss,
-                energy_error=(0.5 * M * v * v + E_diss) / (0.5 * M * V0 * V0) - 1)
+    return dict(F_peak=F_peak, eps=eps, E_diss=E_diss, v_end=v, energy_error=energy_error(v, E_diss, x, g))
 
 
-def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False):
-    """One co-simulation of the h20 drop; returns F_peak, eps (from the
-    striker's final velocity), the energy error and, with trace, the series."""
-    contact = Unit(contact_fmu, "contact", {"law": 2, "scene": 2, "v": V0,
-                                             "m": M if coupling == "mass-aware" else 0.0})
-    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0})
-    force = "F_avg" if coupling == "mass-aware" else "F"
-    F_held = 0.0
+def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False, g=0.0, g_contact=0.0):
+    """One co-simulation of the h20 drop, the striker under gravity g (which
+    the contact's proxy striker knows as g_contact); returns F_peak, eps (from
+    the striker's final velocity), eps_contact (the contact's own, at the
+    separation), the energy error and, with trace, the series."""
+    check_order(coupling, order)
+    contact = Unit(contact_fmu, "contact", contact_values(coupling, g_contact))
+    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0, "g": g})
+    force = FORCE[coupling]
+    F_held = contact.get(force)  # before the first step: F_avg_next is F, 0 at the start
     series = []
     t, n = 0.0, 0
     while t < t_end - 1e-15:
@@ -86,18 +121,18 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
         t = n * H
         if trace:
             series.append((t, contact.get("F"), contact.get("F_avg"), striker.get("v"), striker.get("x")))
-    v_end = striker.get("v")
-    F_peak, E_diss = contact.get("F_peak", "E_diss")
+    v_end, x_end = striker.get("v", "x")
+    F_peak, E_diss, eps_contact = contact.get("F_peak", "E_diss", "eps")
     contact.free()
     striker.free()
-    result = dict(F_peak=F_peak, eps=-v_end / V0, E_diss=E_diss,
-                  energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+    result = dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
+                  energy_error=energy_error(v_end, E_diss, x_end, g))
     if trace:
         result["series"] = series
     return result
 
 
-def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
+def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0, g_contact=0.0):
     """The same scene in libcosim (Open Simulation Platform, via libcosimpy):
     an independent FMI 2.0 importer. Its fixed-step algorithm steps every
     FMU from the last exchanged values: the Jacobi order."""
@@ -111,21 +146,23 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3):
     ex = CosimExecution.from_step_size(step_size=round(H * 1e9))  # libcosim counts nanoseconds
     c = ex.add_local_slave(CosimLocalSlave(fmu_path=str(contact_fmu), instance_name="contact"))
     s = ex.add_local_slave(CosimLocalSlave(fmu_path=str(striker_fmu), instance_name="striker"))
-    ex.integer_initial_value(c, cvr["law"], 2)
-    ex.integer_initial_value(c, cvr["scene"], 2)
-    ex.real_initial_value(c, cvr["v"], V0)
-    ex.real_initial_value(c, cvr["m"], M if coupling == "mass-aware" else 0.0)
+    for name, value in contact_values(coupling, g_contact).items():
+        if isinstance(value, int):
+            ex.integer_initial_value(c, cvr[name], value)
+        else:
+            ex.real_initial_value(c, cvr[name], value)
     ex.real_initial_value(s, svr["m"], M)
     ex.real_initial_value(s, svr["v0"], V0)
+    ex.real_initial_value(s, svr["g"], g)
     ex.connect_real_variables(s, svr["v"], c, cvr["v"])
-    ex.connect_real_variables(c, cvr["F_avg" if coupling == "mass-aware" else "F"], s, svr["F"])
+    ex.connect_real_variables(c, cvr[FORCE[coupling]], s, svr["F"])
     observer = CosimObserver.create_last_value()
     ex.add_observer(observer)
     ex.simulate_until(target_time=round(t_end * 1e9))
-    F_peak, E_diss = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"]])
-    v_end = observer.last_real_values(s, [svr["v"]])[0]
-    return dict(F_peak=F_peak, eps=-v_end / V0, E_diss=E_diss,
-                energy_error=(0.5 * M * v_end ** 2 + E_diss) / (0.5 * M * V0 ** 2) - 1)
+    F_peak, E_diss, eps_contact = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"], cvr["eps"]])
+    v_end, x_end = observer.last_real_values(s, [svr["v"], svr["x"]])
+    return dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
+                energy_error=energy_error(v_end, E_diss, x_end, g))
 
 
 def add_fmu_options(parser):
@@ -153,15 +190,23 @@ def main(argv=None, prog=None):
     parser.add_argument("--order", choices=ORDERS + ("libcosim",), default="gauss-seidel",
                         help="master order, or libcosim to run the scene in libcosim (Jacobi)")
     parser.add_argument("--t-end", type=float, default=3e-3, help="simulated time [s] (default 3e-3)")
+    parser.add_argument("--gravity", type=float, default=0.0,
+                        help="the striker's gravity [m/s^2] (default 0), an external force on it")
+    parser.add_argument("--contact-knows-gravity", action="store_true",
+                        help="give the contact FMU's proxy striker the same gravity (its parameter g)")
     args = parser.parse_args(argv)
     if not args.step > 0:
         parser.error("--step must be positive")
+    if args.coupling == "predictive" and args.order == "gauss-seidel":
+        parser.error("--coupling predictive (F_avg_next) is for Jacobi masters: --order jacobi or libcosim")
     args.contact, args.striker = fmu_paths(parser, args)
+    forces = dict(g=args.gravity, g_contact=args.gravity if args.contact_knows_gravity else 0.0)
     if args.order == "libcosim":
-        r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end)
+        r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end, **forces)
     else:
-        r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end)
-    ref = monolithic(args.contact)
-    print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] - ref["eps"],
+        r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end, **forces)
+    ref = monolithic(args.contact, g=args.gravity)
+    # eps of both from the striker's velocity at t_end (the same as at the separation without gravity)
+    print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] + ref["v_end"] / V0,
                           monolithic=ref)))
 

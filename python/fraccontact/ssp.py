@@ -1,9 +1,9 @@
 """The drop test as an SSP file (build/drop_test.ssp, made by CMake from ssp/):
-the striker and the contact FMU wired for the mass-aware coupling, run by two
-independent SSP importers, fmpy and libcosim (libcosimpy).
+the striker and the contact FMU wired for the predictive coupling (F_avg_next),
+run by two independent SSP importers, fmpy and libcosim (libcosimpy).
 
 Both step every FMU from the values of the last communication point (Jacobi),
-so the results are those of fraccontact.cosim's Jacobi order, mass-aware
+so the results are those of fraccontact.cosim's Jacobi order, predictive
 coupling. Used by the cosim_study report and tests/test_ssp.py.
 """
 
@@ -76,6 +76,6 @@ def run_libcosim(ssp, H, t_end=T_END):
     F_peak, E_diss = observer.last_real_values(contact, [vr["contact"]["F_peak"], vr["contact"]["E_diss"]])
     v_end = observer.last_real_values(striker, [vr["striker"]["v"]])[0]
     # libcosim only warns when a binding fails to apply: report what the contact runs with
-    applied = dict(zip(("scene", "law"), observer.last_integer_values(
-        contact, [vr["contact"]["scene"], vr["contact"]["law"]])))
+    names = ("scene", "law", "coupling")
+    applied = dict(zip(names, observer.last_integer_values(contact, [vr["contact"][n] for n in names])))
     return dict(summary(F_peak, E_diss, v_end), applied=applied)

@@ -42,7 +42,7 @@ from ..progress import progress
 REALS = ["v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k", "c", "dt_max", "g", "gap0"]
 VALUES = {"0": 0.0, "negative": -1.0, "denormal": 5e-324, "huge": 1e300, "NaN": math.nan, "+Inf": math.inf,
           "-Inf": -math.inf}
-OUTPUTS = ["F", "F_avg", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
+OUTPUTS = ["F", "F_avg", "F_avg_next", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
 # The library's defaults (DESIGN.md's interface table): the paper's h20 test.
 DEFAULTS = {name: model.defaults()[name] for name in REALS}
 GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
