@@ -902,13 +902,11 @@ static double polynomial_root(const double *p, int degree)
 /* The first trial of an event's search in an error-controlled step, as a
  * fraction of the step, from the cubic through its ends: where x1 falls to
  * 0 (separation) or where its slope does (the peak). Fixed steps locate
- * their events as they always have: -1, no guess. */
+ * their events as they always have, without a guess. */
 static double event_guess(const contact_model *cm, const contact_state *s, const contact_state *end, double h,
                           int peak)
 {
     double p[4], slope[3];
-    if (!error_controlled(cm))
-        return -1.0;
     indentation_cubic(cm, s, end, h, p);
     if (!peak)
         return polynomial_root(p, 3);
@@ -1057,10 +1055,11 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
 static double onset_step(const contact_model *cm)
 {
     const double n = cm->p.spring_exponent, v = cm->s.v, tol = cm->p.tolerance;
-    const double K = contact_spring_stiffness(cm, 1), Kv = K * pow(v, n - 1.0);
-    double h = fmin(cm->p.dt_max, pow(tol * cm->p.c / Kv, 1.0 / n));
+    double Kv, h;
     if (!(v > 0.0))
         return cm->p.dt_max;
+    Kv = contact_spring_stiffness(cm, 1) * pow(v, n - 1.0);
+    h = fmin(cm->p.dt_max, pow(tol * cm->p.c / Kv, 1.0 / n));
     if (cm->inv_m > 0.0)
         h = fmin(h, pow(tol / (cm->inv_m * Kv), 1.0 / (n + 1.0)));
     return h;
