@@ -1,6 +1,7 @@
 #include "contact.h"
 
 #include <float.h>
+#include <stddef.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -344,8 +345,13 @@ void contact_release(contact_model *cm)
 
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
 {
-    memset(cm, 0, sizeof *cm);
+    /* Everything starts at 0 but the compressed memory's tables (10 kB, most
+     * of the model), which contact_configure fills where they are used: of
+     * them only the modes' state. */
+    memset(cm, 0, offsetof(contact_model, modes));
+    memset(&cm->history, 0, sizeof cm->history);
     contact_configure(cm, p);
+    memset(cm->modes.phi, 0, cm->modes.modes * sizeof *cm->modes.phi);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
@@ -648,7 +654,6 @@ static double sdirk_step(contact_model *cm, const contact_state *in, double h, d
  * 210, and its 6 stages per step cost less than twice the other's 3. */
 #define ESDIRK_STAGES 7
 #define ESDIRK_EMBEDDED 5
-#define ESDIRK_EXPONENT 0.2 /* 1/(embedded order + 1): the error's power of h */
 #define ESDIRK_GAMMA 0.26
 static const double esdirk_a[ESDIRK_STAGES][ESDIRK_STAGES] = {
     {0.0},
@@ -711,7 +716,9 @@ static double esdirk_step(contact_model *cm, const contact_state *in, double h, 
         impulse += h * esdirk_a[last][j] * F[j];
         work += h * esdirk_a[last][j] * F[j] * F[j];
     }
-    length = larger(larger(fabs(in->x1), fabs(X)), larger(peak_indentation(cm, K, in->F_peak_contact), DBL_MIN));
+    length = larger(larger(fabs(in->x1), fabs(X)), DBL_MIN);
+    if (in->F_peak_contact > larger(in->F, F[last])) /* past the peak: its indentation is the larger */
+        length = larger(length, peak_indentation(cm, K, in->F_peak_contact));
     speed = larger(larger(fabs(in->v), fabs(V)), larger(fabs(in->v_onset), DBL_MIN));
     *out = *in;
     out->t = in->t + h;
@@ -736,12 +743,28 @@ static double contact_step(contact_model *cm, const contact_state *in, double h,
     return error_controlled(cm) ? esdirk_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
 }
 
-/* The step after one of length h with error ratio `error` (error over
- * tolerance): the usual controller with a safety factor 0.9, growing at
- * most 5-fold and shrinking at most to `least` of h. */
-static double next_step(double h, double error, double exponent, double least)
+/* x^(-1/5) for x > 0 to within 3e-4 relative: writing x = f 2^e with f in
+ * [0.5, 1) and e = 5q + r, it is f^(-1/5) (a cubic, fitted here) times
+ * 2^(-r/5) times 2^(-q). A step controller needs no more, and it runs on
+ * every step, where pow costs a tenth of an h20 impact. */
+static double inverse_fifth_root(double x)
 {
-    double factor = error > 0.0 ? 0.9 * pow(error, -exponent) : 5.0;
+    static const double two_to_minus_fifths[5] = {1.0, 0.8705505632961241, 0.7578582832551990,
+                                                  0.6597539553864471, 0.5743491774985174};
+    int e, q;
+    double f = frexp(x, &e);
+    q = e >= 0 ? e / 5 : -((4 - e) / 5); /* floor(e / 5) */
+    f = 1.507151444062986 + f * (-1.048043078699986 + f * (0.7816167643411439 - f * 0.24092814993974934));
+    return ldexp(f * two_to_minus_fifths[e - 5 * q], -q);
+}
+
+/* The step after one of length h with error ratio `error` (error over
+ * tolerance): the usual controller 0.9 error^(-1/5) (the embedded
+ * solution's order is 4), growing at most 5-fold and shrinking at most to
+ * `least` of h. */
+static double next_step(double h, double error, double least)
+{
+    double factor = error < DBL_MIN ? 5.0 : error < INFINITY ? 0.9 * inverse_fifth_root(error) : least; /* NaN: least */
     return h * fmin(5.0, fmax(least, factor));
 }
 
@@ -916,16 +939,46 @@ static double event_guess(const contact_model *cm, const contact_state *s, const
     return polynomial_root(slope, 2);
 }
 
-/* How closely the separation in a step of length h from *s is located, as
- * a fraction of h: to rounding with fixed steps; with error-controlled ones
- * to a tenth of the tolerance of the contact's duration so far (the
- * contact time's error; the speed and the dent hardly change there, where
- * the force vanishes). */
+/* How closely an error-controlled step from *s of length h locates the
+ * separation, in seconds: to a tenth of the tolerance of the contact's
+ * duration so far (the contact time's error; the speed and the dent hardly
+ * change there, where the force vanishes). Fixed steps locate it to
+ * rounding. */
 static double separation_precision(const contact_model *cm, const contact_state *s, double h)
 {
-    if (!error_controlled(cm))
-        return 1e-15;
-    return 0.1 * cm->p.tolerance * (s->t + h - s->t_onset) / h;
+    return 0.1 * cm->p.tolerance * (s->t + h - s->t_onset);
+}
+
+/* Where an error-controlled step from *s of length h, whose end *trial lies
+ * past the separation, meets it: a step to where the cubic through its ends
+ * falls to 0, then Newton's method on the indentation at the step's end,
+ * whose slope in the step's length is the indentation rate there, until it
+ * moves by less than the separation's precision (from the cubic's root,
+ * off by O(h^4), one correction usually suffices). The first trial beyond
+ * the tolerance ends the search: the caller rejects it and shrinks the
+ * step. Where Newton's method does not apply (the indentation rising at a
+ * trial, or a correction leaving the step), regula falsi takes over.
+ * Returns the length stepped, its state in *trial and its impulse in *J. */
+static double separation_within(contact_model *cm, const contact_state *s, double h, double K,
+                                contact_state *trial, double *J)
+{
+    const double precision = separation_precision(cm, s, h), x1_end = trial->x1;
+    double tau = event_guess(cm, s, trial, h, 0) * h;
+    int i;
+    for (i = 0; i < 8; i++) {
+        double rate, next;
+        *J = esdirk_step(cm, s, tau, K, trial);
+        rate = indentation_rate(cm, trial);
+        if (trial->error > 1.0)
+            return tau;
+        next = tau - trial->x1 / rate;
+        if (!(rate < 0.0 && next > 0.0 && next <= h))
+            break;
+        if (fabs(next - tau) < precision)
+            return tau;
+        tau = next;
+    }
+    return event_time(cm, s, h, K, indentation, x1_end, precision / h, -1.0, trial, J);
 }
 
 /* The force's peak inside a contact step from *s to *end, if the
@@ -1049,12 +1102,16 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
 
 /* The first error-controlled step of a contact: where the spring's force
  * K (v h)^n, changing the striker's speed by F h / m and turning the rate
- * F / c into the dashpot, has moved the indentation by the tolerance
- * relative to v h; x1^n is not smooth there, and the steps that follow
- * grow at most 5-fold each (grading). */
+ * F / c into the dashpot, has moved the indentation by ONSET_MOVEMENT
+ * tolerances relative to v h; x1^n is not smooth there, and the steps that
+ * follow grow at most 5-fold each (grading). The ESDIRK's error on that
+ * first step is a small part of the movement: measured on the h20 impact
+ * (law 2, tolerance 1e-7), 1e-4 of it, so that a movement of 1000
+ * tolerances leaves an estimated error of 0.09 of the tolerance. */
+#define ONSET_MOVEMENT 1000.0
 static double onset_step(const contact_model *cm)
 {
-    const double n = cm->p.spring_exponent, v = cm->s.v, tol = cm->p.tolerance;
+    const double n = cm->p.spring_exponent, v = cm->s.v, tol = ONSET_MOVEMENT * cm->p.tolerance;
     double Kv, h;
     if (!(v > 0.0))
         return cm->p.dt_max;
@@ -1087,17 +1144,19 @@ static int controlled_internal_step(contact_model *cm, double remaining, double 
         J = esdirk_step(cm, s, tau, K, &trial);
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
-            tau = event_time(cm, s, tau, K, indentation, trial.x1, separation_precision(cm, s, tau),
-                             event_guess(cm, s, &trial, tau, 0), &trial, &J);
+            tau = separation_within(cm, s, tau, K, &trial, &J);
         if (trial.error <= 1.0)
             break;
-        h = next_step(tau, trial.error, ESDIRK_EXPONENT, 0.02);
+        h = next_step(tau, trial.error, 0.02);
     }
     if (rejected > MAX_REJECTED_STEPS)
         return -1;
     /* A step cut short by the interval or the separation keeps the length
-     * the error allowed for the next one. */
-    h_next = fmax(next_step(tau, trial.error, ESDIRK_EXPONENT, 0.1), tau < h ? h : 0.0);
+     * the error allowed for the next one; after a rejection the next does
+     * not grow (Hairer's rule: the error rose faster than h^5 there). */
+    h_next = fmax(next_step(tau, trial.error, 0.1), tau < h ? h : 0.0);
+    if (rejected > 0)
+        h_next = fmin(h_next, tau);
     peak = peak_force_within(cm, s, tau, K, &trial);
     accept_step(cm, &trial);
     s->h_next = h_next;
