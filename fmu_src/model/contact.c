@@ -1,7 +1,6 @@
 #include "contact.h"
 
 #include <float.h>
-#include <stddef.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -345,13 +344,8 @@ void contact_release(contact_model *cm)
 
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
 {
-    /* Everything starts at 0 but the compressed memory's tables (10 kB, most
-     * of the model), which contact_configure fills where they are used: of
-     * them only the modes' state. */
-    memset(cm, 0, offsetof(contact_model, modes));
-    memset(&cm->history, 0, sizeof cm->history);
+    memset(cm, 0, sizeof *cm);
     contact_configure(cm, p);
-    memset(cm->modes.phi, 0, cm->modes.modes * sizeof *cm->modes.phi);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
