@@ -660,7 +660,10 @@ static const double esdirk_a[ESDIRK_STAGES][ESDIRK_STAGES] = {
     {0.1365975117764029144, 0.0, -0.05496908796538376712, -0.04118626728321046868, 0.6299330489901640319,
      0.06962479448202728949, ESDIRK_GAMMA}};
 
+/* The larger and the smaller of two numbers, inline where libm's fmax and
+ * fmin are calls (the controller takes several per step); b when a is NaN. */
 static inline double larger(double a, double b) { return a > b ? a : b; }
+static inline double smaller(double a, double b) { return a < b ? a : b; }
 
 /* The elastic indentation at the contact's peak force so far, kept for the
  * force it was derived from. */
@@ -688,6 +691,7 @@ static double esdirk_step(contact_model *cm, const contact_state *in, double h, 
     double impulse = 0.0, work = 0.0, length, speed;
     int i, j;
     F[0] = in->F;
+#pragma GCC unroll 7
     for (i = 0; i <= last; i++) {
         if (i > 0) {
             double xh = in->x1, vh = in->v;
@@ -759,7 +763,7 @@ static double inverse_fifth_root(double x)
 static double next_step(double h, double error, double least)
 {
     double factor = error < DBL_MIN ? 5.0 : error < INFINITY ? 0.9 * inverse_fifth_root(error) : least; /* NaN: least */
-    return h * fmin(5.0, fmax(least, factor));
+    return h * smaller(larger(factor, least), 5.0);
 }
 
 /* Makes a trial step the model's state, and its memory follow. */
@@ -1132,7 +1136,7 @@ static int controlled_internal_step(contact_model *cm, double remaining, double 
     double h = s->n == 0 ? onset_step(cm) : s->h_next, tau = 0.0, J = 0.0, peak, h_next;
     int rejected, separates = 0;
     for (rejected = 0; rejected <= MAX_REJECTED_STEPS; rejected++) {
-        h = fmin(h, cm->p.dt_max);
+        h = smaller(h, cm->p.dt_max);
         /* the last step lands on the interval's end (forgiving a few ulp) */
         tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
         J = esdirk_step(cm, s, tau, K, &trial);
@@ -1148,9 +1152,9 @@ static int controlled_internal_step(contact_model *cm, double remaining, double 
     /* A step cut short by the interval or the separation keeps the length
      * the error allowed for the next one; after a rejection the next does
      * not grow (Hairer's rule: the error rose faster than h^5 there). */
-    h_next = fmax(next_step(tau, trial.error, 0.1), tau < h ? h : 0.0);
+    h_next = larger(next_step(tau, trial.error, 0.1), tau < h ? h : 0.0);
     if (rejected > 0)
-        h_next = fmin(h_next, tau);
+        h_next = smaller(h_next, tau);
     peak = peak_force_within(cm, s, tau, K, &trial);
     accept_step(cm, &trial);
     s->h_next = h_next;
