@@ -979,25 +979,33 @@ static double separation_within(contact_model *cm, const contact_state *s, doubl
     return event_time(cm, s, h, K, indentation, x1_end, precision / h, -1.0, trial, J);
 }
 
-/* The force's peak inside a contact step from *s to *end, if the
- * indentation turns there: sampling the peak at step ends alone would err by
- * O(h^2) of the force's curvature, more than the scheme itself. With fixed
- * steps the turn is located to rounding; an error-controlled step takes the
- * force one step from *s to where the cubic through the step's ends turns:
- * that time is off by O(h^4) of the motion's scale, and a force read delta
- * from its peak is low by O(delta^2), far below the tolerance. */
-static double peak_force_within(contact_model *cm, const contact_state *s, double h, double K,
-                                const contact_state *end)
+/* The force where the indentation turns inside a contact step from *s to
+ * *end: sampling the peak at step ends alone would err by O(h^2) of the
+ * force's curvature, more than the scheme itself. With fixed steps the turn
+ * is located to rounding; an error-controlled step takes the force one step
+ * from *s to where the cubic through the step's ends turns: that time is
+ * off by O(h^4) of the motion's scale, and a force read delta from its peak
+ * is low by O(delta^2), far below the tolerance. */
+static double force_at_turn(contact_model *cm, const contact_state *s, double h, double K, const contact_state *end)
 {
     contact_state at;
-    double J, f_end = indentation_rate(cm, end);
-    if (!(indentation_rate(cm, s) > 0.0 && f_end <= 0.0))
-        return end->F;
+    double J;
     if (error_controlled(cm))
         contact_step(cm, s, event_guess(cm, s, end, h, 1) * h, K, &at);
     else
-        event_time(cm, s, h, K, indentation_rate, f_end, 1e-15, -1.0, &at, &J);
+        event_time(cm, s, h, K, indentation_rate, indentation_rate(cm, end), 1e-15, -1.0, &at, &J);
     return at.F > end->F ? at.F : end->F;
+}
+
+/* The force's peak inside a contact step from *s to *end: at its end, or
+ * where the indentation turns if it does there (once a contact; the test
+ * inline, since every fixed step makes it). */
+static inline double peak_force_within(contact_model *cm, const contact_state *s, double h, double K,
+                                       const contact_state *end)
+{
+    if (!(indentation_rate(cm, s) > 0.0 && indentation_rate(cm, end) <= 0.0))
+        return end->F;
+    return force_at_turn(cm, s, h, K, end);
 }
 
 /* Contact begins at time t with striker velocity v. */
