@@ -58,9 +58,12 @@ def test_momentum_and_energy_balance():
 
 def test_far_fewer_steps_than_fixed_ones_at_the_same_accuracy(reference):
     """Fixed SDIRK2 steps need dt_max 2.5e-6 s (527 steps) for F_peak within
-    1e-6; the error-controlled steps meet 1e-6 on all four figures at
-    tolerance 1e-7 in about 30."""
-    r = adaptive(1e-7)
+    1e-6; the error-controlled steps meet 1e-6 on all four figures in about
+    35. The tolerance bounds each step's error, and over the contact's dozen
+    or so smooth steps of one sign those add up: measured on this impact the
+    figures come within 15 times the tolerance (eps, the speed's sum, the
+    largest), so 1e-6 takes tolerance 1e-6 / 20."""
+    r = adaptive(5e-8)
     assert r.steps < 60
     for figure in FIGURES:
         assert getattr(r, figure) == pytest.approx(reference[figure], rel=1e-6, abs=0), figure
