@@ -37,9 +37,12 @@ enum contact_memory {
 };
 
 /* The compressed memory's largest number of modes, and the span over which
- * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN. */
+ * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN, or
+ * with error-controlled steps (which go far below dt_max) from the smaller
+ * of dt_max and CONTACT_MEMORY_FLOOR (contact.c says why that floor). */
 #define CONTACT_MAX_MODES 160
 #define CONTACT_MEMORY_SPAN 1e3
+#define CONTACT_MEMORY_FLOOR 1e-9
 
 /* The full G1 history keeps x2 at every step of the run: at most this many
  * steps (8 MiB of history, and as much for the G1 weights). */
@@ -96,8 +99,12 @@ typedef struct {
     /* Not part of the state carried from step to step (so not listed
      * below): what a trial step leaves for accepting it, its length and
      * the damper's rate x2' at its two stages (the second is the end's),
-     * and an error-controlled step's error over the tolerance. */
+     * and an error-controlled step's error over the tolerance; such a step
+     * of a springpot leaves x2' at its stages 2 to 5 too (of stages 0 to 6:
+     * stage 1's is x2_rate1, stage 6's x2_rate, the explicit stage 0's the
+     * start's). */
     double step, x2_rate1, x2_rate, error;
+    double x2_rate_inner[4];
 } contact_state;
 
 /* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,
