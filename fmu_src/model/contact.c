@@ -1503,13 +1503,28 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
     return 0;
 }
 
-/* The next step out of contact while a springpot's memory relaxes. */
+/* The recovery's steps as a fraction of the time since separation. With
+ * error-controlled steps dt_max says nothing of the accuracy wanted: the
+ * fraction whose O(f^2) error (1.2e-6 at 1/16) is the tolerance. */
+static double recovery_fraction(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    if (cm->error_controlled)
+        return fmin(1.0 / 16.0, sqrt(cm->p.tolerance / 1.2e-6) / 16.0);
+    return s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->p.dt_max / s->t_contact) : 1.0 / 16.0;
+}
+
+/* The next step out of contact while a springpot's memory relaxes: at
+ * least dt_max with fixed steps, and with error-controlled ones that
+ * fraction of the step the error allowed at the separation (dt_max may be
+ * far longer than the memory's fastest relaxation then). */
 static double recovery_step(const contact_model *cm, double remaining)
 {
     const contact_state *s = &cm->s;
     const double since = s->impacts > 0 ? s->t - (s->t_onset + s->t_contact) : 0.0;
-    const double f = s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->p.dt_max / s->t_contact) : 1.0 / 16.0;
-    return fmin(remaining, fmax(cm->p.dt_max, f * since));
+    const double f = recovery_fraction(cm);
+    const double least = cm->error_controlled && s->h_next > 0.0 ? f * s->h_next : cm->p.dt_max;
+    return fmin(remaining, fmax(least, f * since));
 }
 
 double contact_advance(contact_model *cm, double H)
