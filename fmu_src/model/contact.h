@@ -178,7 +178,7 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
  * the springpot; damper_order, c_alpha, memory, memory_tolerance with the
  * dashpot; memory_tolerance with the full G1 history), or tolerance > 0
  * where steps stay fixed (the G1 laws with g1_nodes = 0, the central
- * scheme, the springpot). Returns 1 and the
+ * scheme, the springpot's full G1 history). Returns 1 and the
  * message naming such parameters, or 0. */
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
