@@ -26,7 +26,8 @@ static const fc_parameter parameters[] = {
     {"damper_order", FC_REAL, AT(damper_order), "1", "the springpot's order alpha in (0, 1]; 1 is a dashpot (damper 2)"},
     {"c_alpha", FC_REAL, AT(c_alpha), "N.s^alpha/m", "springpot constant: F = c_alpha D^alpha x2 (damper 2)"},
     {"memory_tolerance", FC_REAL, AT(memory_tolerance), "1",
-     "relative error of the compressed memory's kernel, from dt_max to 1000 s (memory 2)"},
+     "relative error of the compressed memory's kernel, from dt_max (error-controlled steps: from min(dt_max, 1e-9 s)) "
+     "to 1000 s (memory 2)"},
     {"tolerance", FC_REAL, AT(tolerance), "1",
      "relative error per internal step (error-controlled ESDIRK steps of at most dt_max); 0 = fixed steps of dt_max"},
     {"dt_max", FC_REAL, AT(dt_max), "s", "largest internal step"},

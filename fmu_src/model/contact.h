@@ -37,9 +37,12 @@ enum contact_memory {
 };
 
 /* The compressed memory's largest number of modes, and the span over which
- * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN. */
+ * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN, or
+ * with error-controlled steps (which go far below dt_max) from the smaller
+ * of dt_max and CONTACT_MEMORY_FLOOR (contact.c says why that floor). */
 #define CONTACT_MAX_MODES 160
 #define CONTACT_MEMORY_SPAN 1e3
+#define CONTACT_MEMORY_FLOOR 1e-9
 
 /* The full G1 history keeps x2 at every step of the run: at most this many
  * steps (8 MiB of history, and as much for the G1 weights). */
@@ -96,8 +99,12 @@ typedef struct {
     /* Not part of the state carried from step to step (so not listed
      * below): what a trial step leaves for accepting it, its length and
      * the damper's rate x2' at its two stages (the second is the end's),
-     * and an error-controlled step's error over the tolerance. */
+     * and an error-controlled step's error over the tolerance; such a step
+     * of a springpot leaves x2' at its stages 2 to 5 too (of stages 0 to 6:
+     * stage 1's is x2_rate1, stage 6's x2_rate, the explicit stage 0's the
+     * start's). */
     double step, x2_rate1, x2_rate, error;
+    double x2_rate_inner[4];
 } contact_state;
 
 /* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,
@@ -171,7 +178,7 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
  * the springpot; damper_order, c_alpha, memory, memory_tolerance with the
  * dashpot; memory_tolerance with the full G1 history), or tolerance > 0
  * where steps stay fixed (the G1 laws with g1_nodes = 0, the central
- * scheme, the springpot). Returns 1 and the
+ * scheme, the springpot's full G1 history). Returns 1 and the
  * message naming such parameters, or 0. */
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
