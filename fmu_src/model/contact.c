@@ -495,7 +495,7 @@ static inline double stage_force(const contact_model *cm, double K, double r, do
         return other_stage_force(cm, K, r, beta, X);
     s = stage_root(r, beta, cm->root_precision);
     *X = s * s;
-    return K * s * s * s;
+    return K * s * *X;
 }
 
 /* What the damper makes of an implicit stage: its rate x2' = (F - A) inv_B,
@@ -512,7 +512,8 @@ typedef struct {
 static inline double implicit_stage(const contact_model *cm, double K, double hg, double xh, double vh,
                                     damper_stage d, double *X, double *V)
 {
-    double r = xh + hg * (vh + hg * cm->accel) + hg * d.A * d.inv_B;
+    /* vh last: in an ESDIRK step it is the latest of the three to be known */
+    double r = (xh + hg * (hg * cm->accel + d.A * d.inv_B)) + hg * vh;
     double F = 0.0;
     if (r > 0.0 && K > 0.0)
         F = stage_force(cm, K, r, K * hg * (d.inv_B + hg * cm->inv_m), X);
@@ -827,7 +828,7 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
 {
     const int last = ESDIRK_STAGES - 1;
     damper_stage damper = {0.0, cm->inv_c};
-    double F[ESDIRK_STAGES], z[ESDIRK_STAGES], x1_rate[ESDIRK_STAGES], v_rate[ESDIRK_STAGES];
+    double F[ESDIRK_STAGES], z[ESDIRK_STAGES], rise[ESDIRK_STAGES];
     double X = in->x1, V = in->v, X_embedded = 0.0, V_embedded = 0.0, x2_embedded = 0.0;
     double impulse = 0.0, work = 0.0, travel = 0.0, length, speed, error;
     int i, j;
@@ -837,10 +838,13 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
         damper.inv_B = esdirk_memory_begin(cm, h, mem);
     for (i = 0; i <= last; i++) {
         if (i > 0) {
+            /* each stage waits on the one before: the sums are ordered so
+             * that its rise and force come in last, at one multiply-add */
             double xh = in->x1, vh = in->v;
             for (j = 0; j < i; j++) {
-                xh += h * esdirk_a[i][j] * x1_rate[j];
-                vh += h * esdirk_a[i][j] * v_rate[j];
+                xh += esdirk_a[i][j] * rise[j];
+                vh += h * esdirk_a[i][j] * cm->accel;
+                vh -= h * esdirk_a[i][j] * cm->inv_m * F[j];
             }
             if (mem)
                 damper.A = esdirk_memory_pull(cm, h, i, z, mem);
@@ -848,9 +852,12 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
             z[i] = (F[i] - damper.A) * damper.inv_B;
             if (mem)
                 esdirk_memory_settle(cm, h, i, z[i], mem);
+            /* h x1' from the stage's equation X = xh + gamma h x1': a
+             * shorter chain than h (V - z) */
+            rise[i] = (X - xh) * (1.0 / ESDIRK_GAMMA);
+        } else {
+            rise[0] = h * (V - z[0]);
         }
-        x1_rate[i] = V - z[i];
-        v_rate[i] = cm->accel - cm->inv_m * F[i];
         if (i == ESDIRK_EMBEDDED) {
             X_embedded = X;
             V_embedded = V;
@@ -918,19 +925,36 @@ static double contact_step(contact_model *cm, const contact_state *in, double h,
     return error_controlled(cm) ? esdirk_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
 }
 
-/* x^(-1/5) for x > 0 to within 3e-4 relative: writing x = f 2^e with f in
- * [0.5, 1) and e = 5q + r, it is f^(-1/5) (a cubic, fitted here) times
- * 2^(-r/5) times 2^(-q). A step controller needs no more, and it runs on
- * every step, where pow costs a tenth of an h20 impact. */
+/* A double's bits and back (IEEE 754 binary64, as on every target). */
+static uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+static double double_of(uint64_t b)
+{
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* x^(-1/5) for normal x > 0 to within 3e-4 relative: writing x = f 2^e
+ * with f in [0.5, 1) and e = 5q + r, it is f^(-1/5) (a cubic, fitted here)
+ * times 2^(-r/5) times 2^(-q), f and e read from x's bits (frexp and ldexp
+ * are library calls: 3 % of an h20 impact). A step controller needs no
+ * more, and it runs on every step, where pow costs a tenth of an impact. */
 static double inverse_fifth_root(double x)
 {
     static const double two_to_minus_fifths[5] = {1.0, 0.8705505632961241, 0.7578582832551990,
                                                   0.6597539553864471, 0.5743491774985174};
-    int e, q;
-    double f = frexp(x, &e);
-    q = e >= 0 ? e / 5 : -((4 - e) / 5); /* floor(e / 5) */
+    const uint64_t b = bits_of(x), mantissa = b & 0x000fffffffffffffu;
+    const int e = (int)(b >> 52) - 1022; /* x normal and positive: no sign, the exponent field 1..2046 */
+    const int q = e >= 0 ? e / 5 : -((4 - e) / 5); /* floor(e / 5) */
+    double f = double_of(mantissa | 0x3fe0000000000000u); /* in [0.5, 1) */
     f = 1.507151444062986 + f * (-1.048043078699986 + f * (0.7816167643411439 - f * 0.24092814993974934));
-    return ldexp(f * two_to_minus_fifths[e - 5 * q], -q);
+    return f * two_to_minus_fifths[e - 5 * q] * double_of((uint64_t)(1023 - q) << 52);
 }
 
 /* The step after one of length h with error ratio `error` (error over
