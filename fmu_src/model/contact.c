@@ -349,7 +349,7 @@ void contact_configure(contact_model *cm, const contact_params *p)
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
     cm->error_controlled = tolerance_applies(p);
-    cm->root_precision = cm->error_controlled ? 1e-3 * p->tolerance : 0.0;
+    cm->series_limit = cm->error_controlled ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
     cm->peak_force_seen = -1.0;
     cm->peak_length = 0.0;
     cm->modes.modes = 0;
@@ -426,28 +426,30 @@ double contact_spring_stiffness(const contact_model *cm, long n_steps)
  *     sqrt(r) (1 - u/2 + 5u^2/8 - u^3 + 231u^4/128 - 7u^5/2 + 7293u^6/1024 - 15u^7 + ...),
  * so for u < 1e-4 (every fixed step of 1e-7 s at the paper's parameters:
  * u ~ 3e-5) the series to u^4 is exact to 4e-20, below rounding; to u^6 it is as
- * accurate as `precision` (relative) while its error, below 20u^7, is (an
- * error-controlled step's u is about 0.01 at the paper's parameters).
+ * accurate as a stage needs while its error, below 20u^7, is: while
+ * u^2 < series_limit (an error-controlled step's u is about 0.01 at the
+ * paper's parameters; series_limit 0: never). The even powers of u are
+ * powers of w = u^2 = beta^2 r and sqrt(r) u = beta r, so the series is
+ * sqrt(r) E(w) + beta r O(w): the two polynomials need no square root and
+ * are ready when it is, a shorter chain on every implicit stage.
  * Otherwise Newton's method, which converges from any start at or above the
  * root and from a close one below it because the cubic increases and is
  * convex for s > 0: from that series (off by < 20u^7, 1.6e-8 at most)
  * while u < 0.05, from sqrt(r) / (1 + u/2) (off by < u^2/2) while u <= 1,
  * and from cbrt(r / beta), above the root, when the split is stiff (u > 1). */
-static double stage_root(double r, double beta, double precision)
+static double stage_root(double r, double beta, double series_limit)
 {
-    double s = sqrt(r), u = beta * s, ds;
+    const double w = beta * beta * r, odd = beta * r;
+    double s = sqrt(r), ds;
     int i;
-    if (u < 1e-4) /* the fixed steps' case: to u^4, exact to 4e-20 */
-        return s * (1.0 - u * (0.5 - u * (0.625 - u * (1.0 - u * (231.0 / 128.0)))));
-    if (u < 0.05) {
-        /* Estrin's scheme: pairs of terms side by side, a shorter chain of
-         * dependent operations than Horner's on every implicit stage */
-        const double u2 = u * u, u4 = u2 * u2;
-        s *= (1.0 - 0.5 * u) + u2 * (0.625 - u) + u4 * ((231.0 / 128.0 - 3.5 * u) + u2 * (7293.0 / 1024.0));
-        if (20.0 * u4 * u2 * u < precision)
+    if (w < 1e-8) /* u < 1e-4, the fixed steps' case: to u^4, exact to 4e-20 */
+        return s * (1.0 + w * (0.625 + w * (231.0 / 128.0))) - odd * (0.5 + w);
+    if (w < 0.0025) { /* u < 0.05 */
+        s = s * (1.0 + w * (0.625 + w * (231.0 / 128.0 + w * (7293.0 / 1024.0)))) - odd * (0.5 + w * (1.0 + 3.5 * w));
+        if (w < series_limit)
             return s;
     } else {
-        s = u > 1.0 ? cbrt(r / beta) : s / (1.0 + 0.5 * u);
+        s = w > 1.0 ? cbrt(r / beta) : s / (1.0 + 0.5 * beta * s);
     }
     for (i = 0; i < 200; i++) {
         ds = (s * s * (1.0 + beta * s) - r) / (s * (2.0 + 3.0 * beta * s));
@@ -493,7 +495,7 @@ static inline double stage_force(const contact_model *cm, double K, double r, do
     double s;
     if (cm->p.spring_exponent != 1.5)
         return other_stage_force(cm, K, r, beta, X);
-    s = stage_root(r, beta, cm->root_precision);
+    s = stage_root(r, beta, cm->series_limit);
     *X = s * s;
     return K * s * *X;
 }

@@ -149,7 +149,8 @@ typedef struct {
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
     int error_controlled;   /* tolerance > 0 where it applies: error-controlled steps */
-    double root_precision;  /* relative accuracy an implicit stage's root needs (0: to rounding) */
+    double series_limit;    /* an implicit stage's root is its series while (beta^2 r) is below this (stage_root):
+                               its error, 20 u^7, is then within 1e-3 of the tolerance; 0: to rounding */
     double peak_force_seen, peak_length; /* error control's cache: a force and its elastic indentation */
     contact_state s;
     contact_modes modes;      /* a springpot's compressed memory */
