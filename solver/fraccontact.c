@@ -159,6 +159,13 @@ int fc_params_warning(const fc_params *p, char *msg, size_t len)
     return contact_unused_value(&q, msg, len);
 }
 
+int fc_error_controlled(const fc_params *p)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    return contact_error_controlled(&q);
+}
+
 /* t_c v / x_max of an elastic impact on the spring k x1^n (MODEL.md §2):
  * 2 integral_0^1 (1 - u^(n+1))^(-1/2) du = 2/(n+1) B(1/(n+1), 1/2). */
 static double elastic_contact_time(double n)

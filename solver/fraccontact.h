@@ -89,6 +89,10 @@ FC_API double fc_drop_velocity(double height);
  * the other damper's parameters), else 0. */
 FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 
+/* 1 when the run chooses its steps by p->tolerance (Kvaerno's ESDIRK 5(4)),
+ * 0 when it takes fixed steps of dt_max. */
+FC_API int fc_error_controlled(const fc_params *p);
+
 /* What fc_parameter_at tells of each member of fc_params. */
 typedef enum { FC_REAL = 0, FC_INTEGER = 1 } fc_kind;
 

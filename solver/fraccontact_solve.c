@@ -168,8 +168,8 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, central, bdf2-g1 (a springpot's full G1 history) or reference; the\n"
-           "               spring constant used [N/m^n]\n"
+           "  method, k    sdirk2, esdirk5 (error-controlled steps, tolerance > 0), central, bdf2-g1 (a\n"
+           "               springpot's full G1 history) or reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
 }
@@ -428,6 +428,8 @@ static const char *method_name(const options *o)
         return "reference";
     if (o->p.damper == 2 && o->p.memory == 1)
         return "bdf2-g1"; /* the full G1 history's own scheme */
+    if (fc_error_controlled(&o->p))
+        return "esdirk5"; /* error-controlled steps: Kvaerno's ESDIRK 5(4) */
     return o->p.scheme == 2 ? "central" : "sdirk2";
 }
 

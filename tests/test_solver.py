@@ -52,6 +52,19 @@ def test_json_has_the_promised_keys():
     assert set(r["end"]) == {"t", "F_peak", "eps", "t_contact", "E_diss", "x", "x1", "x2", "v"}
 
 
+@pytest.mark.parametrize("args, method", [
+    ([], "sdirk2"), (["--scheme", "central"], "central"), (["--reference"], "reference"),
+    (["--damper", "2", "--memory", "1"], "bdf2-g1"),
+    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3"], "esdirk5"),
+    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3", "--damper", "2", "--memory", "2"], "esdirk5"),
+    (["--law", "1", "--tolerance", "1e-6"], "sdirk2")])  # G1 with N = steps: fixed steps (and a warning)
+def test_json_names_the_method_that_ran(args, method):
+    r = solve_json("--t-end", "2e-3", *args)
+    assert r["method"] == method
+    if method == "esdirk5":  # its own steps, not dt_max's: the 1.3 ms contact in far fewer than 1e-3/1e-7
+        assert r["steps"] < 1000
+
+
 @pytest.mark.parametrize("args, says", [
     (["--c", "-1"], "c = -1"), (["--c", "abc"], "--c 'abc'"), (["--bogus", "1"], "--bogus"),
     (["--law", "foo"], "--law 'foo'"), (["--dt-max", "0"], "dt_max = 0"), (["--m", "0"], "m = 0"),

@@ -262,6 +262,8 @@ static const char *fixed_steps_only(const contact_params *p)
 
 static int tolerance_applies(const contact_params *p) { return p->tolerance > 0.0 && !fixed_steps_only(p); }
 
+int contact_error_controlled(const contact_params *p) { return tolerance_applies(p); }
+
 /* The shortest time over which the compressed memory's kernel holds its
  * tolerance. Fixed steps never go below dt_max. Error-controlled steps do,
  * far below it (the h20 impact's first steps at tolerance 1e-6 are about

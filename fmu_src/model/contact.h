@@ -183,6 +183,10 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
  * message naming such parameters, or 0. */
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
+/* 1 when the model chooses its steps by p->tolerance (tolerance > 0 where
+ * it applies), 0 when it takes fixed steps of dt_max. */
+int contact_error_controlled(const contact_params *p);
+
 /* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
  * `scene` with the parameters *p (which must have passed their check): a
  * run must also be able to hold its energies and powers in doubles. */
