@@ -1,8 +1,9 @@
-/* The striker FMU: a rigid body of mass m under gravity g and the contact
- * force F (input, pushing against its motion towards the specimen). Its
- * position x (towards the specimen, the contact element's indentation
- * coordinate) and velocity v are the outputs. With F held over a step the
- * motion is a parabola, integrated exactly. */
+/* The striker FMU: a rigid body of mass m under gravity g, a spring k_s
+ * holding it at x0 and the contact force F (input, pushing against its
+ * motion towards the specimen). Its position x (towards the specimen, the
+ * contact element's indentation coordinate) and velocity v are the outputs.
+ * With F held over a step the motion is a parabola, or with the spring a
+ * harmonic oscillation, integrated exactly. */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -11,11 +12,11 @@
 #include "fmu_interface.h"
 #include "fmu_vars.h"
 
-enum { VR_F = 1, VR_m = 2, VR_g = 3, VR_x0 = 4, VR_v0 = 5, VR_x = 6, VR_v = 7 };
+enum { VR_F = 1, VR_m = 2, VR_g = 3, VR_x0 = 4, VR_v0 = 5, VR_x = 6, VR_v = 7, VR_k_s = 8 };
 
 struct fmu_model {
     double F;              /* input: contact force on the striker [N] */
-    double m, g, x0, v0;   /* parameters */
+    double m, g, x0, v0, k_s; /* parameters */
     double t, x, v;        /* state */
     int started;
     fmu_reporter log;
@@ -29,6 +30,7 @@ static const fmu_variable variable_list[] = {
     {VR_v0, "v0", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, v0)},
     {VR_x, "x", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, x)},
     {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
+    {VR_k_s, "k_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, k_s)},
 };
 
 static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
@@ -66,6 +68,8 @@ static const char *rule_broken(unsigned vr, double value)
         return "must be finite";
     if (vr == VR_m && !(value > 0.0))
         return "the striker mass must be positive [kg]";
+    if (vr == VR_k_s && value < 0.0)
+        return "the spring's stiffness must not be negative [N/m]";
     return NULL;
 }
 
@@ -126,6 +130,12 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
     return none_of(fm, vr, VAR_BOOLEAN);
 }
 
+/* v' at the step's start: gravity, the held force and the spring. */
+static double acceleration(const fmu_model *fm)
+{
+    return fm->g - fm->F / fm->m - fm->k_s / fm->m * (fm->x - fm->x0);
+}
+
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
 {
     (void)value;
@@ -141,7 +151,7 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
         return FM_OK;
     }
     if (order == 1 && vr == VR_v) {
-        *value = fm->g - fm->F / fm->m;
+        *value = acceleration(fm);
         return FM_OK;
     }
     return fmu_say(&fm->log, FM_ERROR, "logStatusError",
@@ -157,11 +167,21 @@ fm_status fm_start(fmu_model *fm, double t0)
     return FM_OK;
 }
 
+/* With F held over a step: x'' = a - w^2 (x - x0), a = g - F/m,
+ * w^2 = k_s/m. Without the spring a parabola; with it an oscillation
+ * about x0 + a/w^2. */
 fm_status fm_do_step(fmu_model *fm, double t, double H)
 {
-    double a = fm->g - fm->F / fm->m;
-    fm->x += H * (fm->v + 0.5 * H * a);
-    fm->v += H * a;
+    const double a = fm->g - fm->F / fm->m;
+    if (fm->k_s > 0.0) {
+        const double w = sqrt(fm->k_s / fm->m), c = cos(w * H), s = sin(w * H);
+        const double rest = fm->x0 + a / (w * w), d = fm->x - rest, v = fm->v;
+        fm->x = rest + d * c + v / w * s;
+        fm->v = v * c - d * w * s;
+    } else {
+        fm->x += H * (fm->v + 0.5 * H * a);
+        fm->v += H * a;
+    }
     fm->t = t + H;
     return FM_OK;
 }
@@ -173,7 +193,7 @@ double fm_time(const fmu_model *fm)
 
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
-static const state_field state_fields[] = {F(F), F(m), F(g), F(x0), F(v0), F(t), F(x), F(v),
+static const state_field state_fields[] = {F(F), F(m), F(g), F(x0), F(v0), F(k_s), F(t), F(x), F(v),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
@@ -196,6 +216,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
     fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
+        || rule_broken(VR_k_s, trial.k_s)
         || (trial.started != 0 && trial.started != 1))
         return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
     *fm = trial;

@@ -31,6 +31,7 @@ from fmpy import read_model_description
 
 from . import fmu_path, model
 from .fmu import Slave, unpacked
+from .scipy_contact import solve_drop
 
 M, V0 = model.defaults()["m"], model.defaults()["v"]  # the h20 drop test's striker
 COUPLINGS = ("zoh", "mass-aware", "predictive")
@@ -57,10 +58,11 @@ def check_order(coupling, order):
                          "a Gauss-Seidel master connects F_avg (mass-aware)")
 
 
-def energy_error(v_end, E_diss, x_end=0.0, g=0.0):
+def energy_error(v_end, E_diss, x_end=0.0, g=0.0, k_s=0.0):
     """(kinetic energy at the end + the work dissipated - gravity's work on
-    the striker) over the impact energy, less 1: > 0 is energy created."""
-    return (0.5 * M * v_end ** 2 + E_diss - M * g * x_end) / (0.5 * M * V0 ** 2) - 1
+    the striker + the energy in its spring) over the impact energy, less 1:
+    > 0 is energy created."""
+    return (0.5 * M * v_end ** 2 + E_diss - M * g * x_end + 0.5 * k_s * x_end ** 2) / (0.5 * M * V0 ** 2) - 1
 
 
 class Unit(Slave):
@@ -93,14 +95,25 @@ def monolithic(contact_fmu, t_end=3e-3, H=1e-5, law=2, g=0.0):
     return dict(F_peak=F_peak, eps=eps, E_diss=E_diss, v_end=v, energy_error=energy_error(v, E_diss, x, g))
 
 
-def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False, g=0.0, g_contact=0.0):
+def spring_reference(k_s):
+    """The h20 drop with the striker held by a spring k_s where the contact
+    begins, which no contact FMU parameter describes: scipy's solution of
+    the same ODE (the FMU's Hertz law, k and c its defaults), to its
+    separation: F_peak, eps, and the rest of solve_drop's figures."""
+    d = model.defaults()
+    return solve_drop(d["k"], d["c"], M, V0, method="DOP853", rtol=1e-12, k_s=k_s)
+
+
+def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False, g=0.0, g_contact=0.0,
+               k_s=0.0):
     """One co-simulation of the h20 drop, the striker under gravity g (which
-    the contact's proxy striker knows as g_contact); returns F_peak, eps (from
+    the contact's proxy striker knows as g_contact) and held by a spring k_s
+    at its start (which the contact does not know); returns F_peak, eps (from
     the striker's final velocity), eps_contact (the contact's own, at the
     separation), the energy error and, with trace, the series."""
     check_order(coupling, order)
     contact = Unit(contact_fmu, "contact", contact_values(coupling, g_contact))
-    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0, "g": g})
+    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0, "g": g, "k_s": k_s})
     force = FORCE[coupling]
     F_held = contact.get(force)  # before the first step: F_avg_next is F, 0 at the start
     series = []
@@ -126,13 +139,13 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     contact.free()
     striker.free()
     result = dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
-                  energy_error=energy_error(v_end, E_diss, x_end, g))
+                  energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
     if trace:
         result["series"] = series
     return result
 
 
-def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0, g_contact=0.0):
+def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0, g_contact=0.0, k_s=0.0):
     """The same scene in libcosim (Open Simulation Platform, via libcosimpy):
     an independent FMI 2.0 importer. Its fixed-step algorithm steps every
     FMU from the last exchanged values: the Jacobi order."""
@@ -154,6 +167,7 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0
     ex.real_initial_value(s, svr["m"], M)
     ex.real_initial_value(s, svr["v0"], V0)
     ex.real_initial_value(s, svr["g"], g)
+    ex.real_initial_value(s, svr["k_s"], k_s)
     ex.connect_real_variables(s, svr["v"], c, cvr["v"])
     ex.connect_real_variables(c, cvr[FORCE[coupling]], s, svr["F"])
     observer = CosimObserver.create_last_value()
@@ -162,7 +176,7 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0
     F_peak, E_diss, eps_contact = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"], cvr["eps"]])
     v_end, x_end = observer.last_real_values(s, [svr["v"], svr["x"]])
     return dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
-                energy_error=energy_error(v_end, E_diss, x_end, g))
+                energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
 
 
 def add_fmu_options(parser):
@@ -194,17 +208,29 @@ def main(argv=None, prog=None):
                         help="the striker's gravity [m/s^2] (default 0), an external force on it")
     parser.add_argument("--contact-knows-gravity", action="store_true",
                         help="give the contact FMU's proxy striker the same gravity (its parameter g)")
+    parser.add_argument("--k-s", type=float, default=0.0,
+                        help="stiffness of a spring holding the striker where the contact begins [N/m] (default 0), "
+                             "an external force the contact does not know; judged against scipy's solution")
     args = parser.parse_args(argv)
     if not args.step > 0:
         parser.error("--step must be positive")
+    if not args.k_s >= 0:
+        parser.error(f"--k-s must be 0 or positive, not {args.k_s:g}")
+    if args.k_s > 0 and args.gravity != 0:
+        parser.error("--k-s with --gravity: there is no reference for both")
     if args.coupling == "predictive" and args.order == "gauss-seidel":
         parser.error("--coupling predictive (F_avg_next) is for Jacobi masters: --order jacobi or libcosim")
     args.contact, args.striker = fmu_paths(parser, args)
-    forces = dict(g=args.gravity, g_contact=args.gravity if args.contact_knows_gravity else 0.0)
+    forces = dict(g=args.gravity, g_contact=args.gravity if args.contact_knows_gravity else 0.0, k_s=args.k_s)
     if args.order == "libcosim":
         r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end, **forces)
     else:
         r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end, **forces)
+    if args.k_s > 0:  # the spring keeps acting after the separation: eps is the contact's, at the separation
+        ref = spring_reference(args.k_s)
+        print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
+                              eps_error=r["eps_contact"] - ref["eps"], reference=ref)))
+        return
     ref = monolithic(args.contact, g=args.gravity)
     # eps of both from the striker's velocity at t_end (the same as at the separation without gravity)
     print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] + ref["v_end"] / V0,

@@ -1,10 +1,11 @@
 """The contact ODE of MODEL.md §2 solved with scipy's solve_ivp: a second
 implementation, independent of the C code, for the tests and the reports.
 
-    x1' = v - F/c,  v' = -F/m,  x2' = F/c,  E_diss' = F^2/c,  F = k max(x1, 0)^(3/2)
+    x1' = v - F/c,  v' = -(F + k_s x)/m,  x2' = F/c,  E_diss' = F^2/c,  F = k max(x1, 0)^(3/2)
 
 from contact (x1 = 0, v = v0) to separation (x1 back to 0), the force's peak
-located where x1' = 0.
+located where x1' = 0; k_s is a spring on the striker, holding it where the
+contact began (x = x1 + x2 = 0; none by default).
 """
 
 import numpy as np
@@ -18,7 +19,7 @@ from .hertz import indentation
 T0 = 1e-12
 
 
-def solve_drop(k, c, m, v0, method="DOP853", rtol=1e-13, t_end=1.0, t_grid=None):
+def solve_drop(k, c, m, v0, method="DOP853", rtol=1e-13, t_end=1.0, t_grid=None, k_s=0.0):
     """The first impact of a drop test. Returns F_peak, eps, t_contact, x2
     (permanent indentation), E_diss, v_end, separated, nfev, and with t_grid
     the force F on that grid (0 after separation)."""
@@ -27,7 +28,7 @@ def solve_drop(k, c, m, v0, method="DOP853", rtol=1e-13, t_end=1.0, t_grid=None)
 
     def rhs(t, y):
         F = force(y[0])
-        return [y[1] - F / c, -F / m, F / c, F * F / c]
+        return [y[1] - F / c, -(F + k_s * (y[0] + y[2])) / m, F / c, F * F / c]
 
     def separation(t, y):
         return y[0]
