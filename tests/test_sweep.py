@@ -192,7 +192,7 @@ def test_statistics_are_numpys_on_the_csv(monte_carlo):
     (["--vary", "height=0.1:0.01:0.01"], "stop >= start"),
     (["--vary", "bogus=1"], "unknown parameter 'bogus'"),
     (["--monte-carlo", "5"], "needs at least one --scatter"),
-    (["--workers", "0"], "must be >= 1"),
+    (["--workers", "0"], "--workers 0: a local cluster has 1 to"),
     (["--monte-carlo", "5", "--scatter", "c=-0.1"], "negative"),
     (["--monte-carlo", "5", "--scatter", "g=0.1"], "positive nominal"),
     (["--monte-carlo", "5", "--scatter", "g1_nodes=0.1"], "only real"),

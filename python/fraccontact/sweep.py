@@ -17,15 +17,31 @@ nu_i, E_s, nu_s, k, c, law, g1_nodes, dt_max, scene, g, gap0, the scheme and
 the stop conditions t_end and impacts), or height (the drop height: v =
 sqrt(2 g h)); - or _ alike: E_s or E-s, t_end or t-end. Real parameters
 take a grid a:b:step or a list v1,v2, integer ones too; law, scene and
-scheme also their words (law=g1,hertz,g1x).
+scheme also their words (law=g1,hertz,g1x). A name is given once: set
+(--set), varied (--vary) or, in a Monte Carlo campaign, scattered around
+its --set value (--scatter); height and v are one quantity, given once.
+
+A grid a:b:step holds a + i step for i = 0, 1, ... while it does not pass
+b, computed exactly from the numbers as typed (decimal) and then rounded
+to the nearest double: 0.005:0.1:0.005 gives 0.005, 0.01, ..., 0.035, ...,
+0.1, and b is in the grid when it is a + i step exactly. A sweep holds every
+case and result in memory: at most 1 000 000 impacts (the product of the
+grids' sizes, or --monte-carlo N); split a larger campaign.
+
+A material (R, E_i, nu_i, E_s, nu_s) acts only through the Hertz constant
+it gives when k = 0: the library's default k (the paper's fitted one) wins
+over it. To sweep a material, --set k=0 --vary E_s=1e9,2e9; the sweep
+warns, with the library's message, when a value it is given has no effect.
 
 The default law: g1, the library's own (the G1 history sum, the model the
 README describes); --set law=hertz for the closed form.
 
-Monte Carlo: --scatter NAME=S draws NAME log-normally, with mean its nominal
-value (--set NAME=VALUE, else the library's default) and coefficient of
-variation S (standard deviation / mean), a fraction (0.05) or a percentage
-(5%). Log-normal, it stays positive at any S. Only real parameters with a
+Monte Carlo: --monte-carlo N (N >= 1) draws N impacts instead of a grid
+(no --vary beside it; --scatter and --seed only with it). --scatter
+NAME=S draws NAME log-normally, with mean its nominal value (--set
+NAME=VALUE, else the library's default) and coefficient of variation S
+(standard deviation / mean), a fraction (0.05) or a percentage (5%).
+Log-normal, it stays positive at any S. Only real parameters with a
 positive nominal value scatter: a relative scatter of zero (g, gap0 at
 their defaults) or of a negative value means nothing, so those are refused,
 as is a negative S.
@@ -40,8 +56,10 @@ also the mean, sample standard deviation and 5/50/95 % percentiles of every
 numeric column over the impacts that succeeded, which are printed too).
 
 Runs on a local Dask cluster (--workers processes) or on any running Dask
-scheduler (--scheduler ADDRESS), whose workers must import fraccontact (pip
-install .). The wall time and the impacts per second count the Dask tasks
+scheduler (--scheduler ADDRESS, refused when none answers there within 5 s;
+--workers is the local cluster's), whose workers must import fraccontact
+(pip install .). Every option is checked, and --out too, before the
+cluster starts. The wall time and the impacts per second count the Dask tasks
 alone, from the first submitted to the last finished (before, each worker
 has imported the package and run the first case once).
 """
@@ -52,9 +70,12 @@ import importlib
 import itertools
 import json
 import math
+import os
 import pathlib
 import sys
 import time
+import warnings
+from fractions import Fraction
 
 import numpy as np
 
@@ -62,6 +83,14 @@ from . import atomic, model
 from .progress import progress
 
 DEFAULT_HEIGHTS = "0.005:0.1:0.005"
+# The most impacts a sweep runs: it holds every case and every result row
+# in memory on the client, as Python objects.
+MAX_IMPACTS = 1_000_000
+# How long --scheduler waits for its scheduler to answer [s]: a scheduler
+# that is up answers at once, and a wrong address should not cost longer.
+CONNECT_TIMEOUT = 5
+OUTPUTS = ("sweep.csv", "sweep.png", "sweep.json")
+WORKERS = 2  # the local cluster's worker processes by default
 HEIGHT = dict(name="height", kind="real", unit="m", default=None, help="drop height: v = sqrt(2 g h)")
 # The results of a run, as fraccontact.impacts returns them: the first
 # impact's figures (NaN where none ended), then the run's counts and k.
@@ -107,52 +136,88 @@ def value(entry, text):
         return float(text) if kind == "real" else int(text)
     except ValueError:
         if words:
-            raise ValueError(f"{name}={text}: {name} is one of {', '.join(words)} "
+            raise ValueError(f"'{text}' is not one of {', '.join(words)} "
                              f"(or {', '.join(map(str, words.values()))})") from None
-        raise ValueError(f"{name}={text}: not {'a number' if kind == 'real' else 'a whole number'}") from None
+        raise ValueError(f"'{text}' is not {'a number' if kind == 'real' else 'a whole number'}") from None
 
 
 def values(entry, spec):
-    """'a:b:step' (inclusive; real and integer parameters), or 'v1,v2,...'."""
+    """'start:stop:step' (real and integer parameters; grid()), or 'v1,v2,...'."""
     if ":" not in spec:
         return [value(entry, v) for v in spec.split(",")]
     bounds = spec.split(":")
     if len(bounds) != 3:
-        raise ValueError(f"'{spec}': a grid is start:stop:step")
-    start, stop, step = (value(entry, x) for x in bounds)
-    if isinstance(start, str) or isinstance(stop, str) or isinstance(step, str):
-        raise ValueError(f"'{spec}': a grid start:stop:step takes numbers")
+        raise ValueError("a grid is start:stop:step")
+    numbers = [value(entry, x) for x in bounds]
+    if any(isinstance(x, str) for x in numbers):
+        raise ValueError("a grid start:stop:step takes numbers")
+    if not all(math.isfinite(x) for x in numbers):
+        raise ValueError("a grid's start, stop and step are finite numbers")
+    start, stop, step = (Fraction(x.strip()) for x in bounds)
     if not step > 0 or stop < start:
-        raise ValueError(f"'{spec}': start:stop:step needs step > 0 and stop >= start")
-    n = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return [round(start + i * step, 12) for i in range(n)]
+        raise ValueError("start:stop:step needs step > 0 and stop >= start")
+    n = math.floor((stop - start) / step) + 1
+    if n > MAX_IMPACTS:
+        raise ValueError(f"{n} values, more than the {MAX_IMPACTS} impacts a sweep runs (it holds them all in memory)")
+    return grid(start, step, n, entry["kind"])
+
+
+def grid(start, step, n, kind):
+    """start + i step for i < n, computed exactly (start and step are the
+    decimal numbers typed) and then rounded to the nearest double: the
+    values asked for, where adding doubles would drift (0.005 + 6 * 0.005
+    is 0.034999999999999996 in doubles). Integer parameters stay integers.
+    Refused when the step is below what doubles resolve there."""
+    if kind != "real":
+        return [int(start + i * step) for i in range(n)]
+    scale = math.lcm(start.denominator, step.denominator)
+    first, stride = start.numerator * (scale // start.denominator), step.numerator * (scale // step.denominator)
+    out = [(first + i * stride) / scale for i in range(n)]  # integer division rounds correctly
+    if len(set(out)) < n:
+        raise ValueError("the step is below what doubles resolve at these values: the grid would repeat them")
+    return out
 
 
 def scatter(entry, text):
     """The coefficient of variation in '0.05' or '5%'."""
     name = entry["name"]
     if entry["kind"] != "real":
-        raise ValueError(f"--scatter {name}: only real parameters scatter, {name} is {entry['kind']}")
+        raise ValueError(f"only real parameters scatter, {name} is {entry['kind']}")
     try:
         cv = float(text[:-1]) / 100 if text.endswith("%") else float(text)
     except ValueError:
-        raise ValueError(f"--scatter {name}={text}: a fraction (0.05) or a percentage (5%)") from None
+        raise ValueError("a fraction (0.05) or a percentage (5%)") from None
     if not 0 <= cv < math.inf:
-        raise ValueError(f"--scatter {name}={text}: the scatter is a coefficient of variation (standard deviation "
-                         "/ mean), finite and never negative")
+        raise ValueError("the scatter is a coefficient of variation (standard deviation / mean), finite and never "
+                         "negative")
     return cv
 
 
-def pairs(table, texts, convert):
-    """[(name, convert(entry, value))] of NAME=VALUE texts, each name as the
+def named(table, option, texts):
+    """[(name, spec, text)] of the option's NAME=SPEC texts, each name as the
     library spells it."""
     out = []
     for text in texts:
         name, sep, spec = text.partition("=")
         if not sep or not spec.strip():
-            raise ValueError(f"'{text}': NAME=VALUE expected")
-        entry = parameter(table, name.strip().lstrip("-"))
-        out.append((entry["name"], convert(entry, spec.strip())))
+            raise ValueError(f"{option} {text}: NAME=VALUE expected")
+        try:
+            entry = parameter(table, name.strip().lstrip("-"))
+        except ValueError as e:
+            raise ValueError(f"{option} {text}: {e}") from None
+        out.append((entry["name"], spec.strip(), text))
+    return out
+
+
+def converted(table, option, given, convert):
+    """[(name, convert(entry, spec))] of named() texts; a refusal names the
+    option and the text."""
+    out = []
+    for name, spec, text in given:
+        try:
+            out.append((name, convert(table[name], spec)))
+        except ValueError as e:
+            raise ValueError(f"{option} {text}: {e}") from None
     return out
 
 
@@ -176,8 +241,75 @@ def log_normal(rng, mean, cv, n):
     return rng.lognormal(math.log(mean) - variance / 2, math.sqrt(variance), n)
 
 
+def refuse_conflicts(args, vary, fixed, scattered):
+    """Refuses options that contradict each other or would be ignored (the
+    named() texts of --vary, --set and --scatter): each name given once,
+    height and v not both, a Monte Carlo campaign's options only with it
+    and never beside a grid, --workers only for the local cluster."""
+    for option, given in (("--vary", vary), ("--set", fixed), ("--scatter", scattered)):
+        seen = {}
+        for name, _, text in given:
+            if name in seen:
+                raise ValueError(f"{option} {seen[name]} and {option} {text}: {name} is given twice")
+            seen[name] = text
+    set_texts = {name: text for name, _, text in fixed}
+    for name, _, text in vary:
+        if name in set_texts:
+            raise ValueError(f"--set {set_texts[name]} and --vary {text}: a parameter is either held (--set) or "
+                             "varied (--vary), not both")
+    speeds = [(option, name, text) for option, given in (("--vary", vary), ("--set", fixed), ("--scatter", scattered))
+              for name, _, text in given if name in ("height", "v")]
+    if len({name for _, name, _ in speeds}) > 1:
+        raise ValueError(f"{' and '.join(f'{o} {t}' for o, _, t in speeds)}: height sets v (v = sqrt(2 g h)); give "
+                         "one of them")
+    if args.monte_carlo is None:
+        if scattered:
+            raise ValueError(f"--scatter {scattered[0][2]} without --monte-carlo N: only a Monte Carlo campaign "
+                             "draws values (a grid takes --vary)")
+        if args.seed is not None:
+            raise ValueError(f"--seed {args.seed} without --monte-carlo N: a grid draws nothing at random")
+        if not vary and speeds:
+            raise ValueError(f"{speeds[0][0]} {speeds[0][2]} without --vary: the default sweep varies height; "
+                             "give --vary NAME=VALUES for what to sweep")
+    else:
+        if not 1 <= args.monte_carlo <= MAX_IMPACTS:
+            raise ValueError(f"--monte-carlo {args.monte_carlo}: the number of impacts must lie in [1, "
+                             f"{MAX_IMPACTS}] (a sweep holds them all in memory)")
+        if not scattered:
+            raise ValueError(f"--monte-carlo {args.monte_carlo} needs at least one --scatter NAME=S")
+        if vary:
+            raise ValueError(f"--vary {vary[0][2]} with --monte-carlo: a Monte Carlo campaign draws its cases "
+                             "(--scatter) instead of a grid; hold the other parameters with --set")
+    if args.seed is not None and args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: a seed is a whole number >= 0")
+    if args.workers is not None and args.scheduler:
+        raise ValueError(f"--workers {args.workers} with --scheduler: the scheduler's workers run the sweep; "
+                         "--workers sizes the local cluster")
+    if args.workers is not None and not 1 <= args.workers <= cpus():
+        raise ValueError(f"--workers {args.workers}: a local cluster has 1 to {cpus()} worker processes, this "
+                         "machine's CPUs (more would only compete for them)")
+    if args.batch < 0:
+        raise ValueError(f"--batch {args.batch}: impacts per Dask task, >= 1 (or 0, the default)")
+
+
+def cpus():
+    """The CPUs this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def grid_size(texts, vary):
+    """The number of impacts of the grid over the --vary values (texts as
+    given), refused beyond MAX_IMPACTS before the grid is built."""
+    n = math.prod(len(v) for _, v in vary)
+    if n > MAX_IMPACTS:
+        raise ValueError(f"{' '.join(f'--vary {text}' for _, _, text in texts)}: a grid of "
+                         f"{' x '.join(str(len(v)) for _, v in vary)} = {n} impacts, more than the {MAX_IMPACTS} "
+                         "a sweep runs (it holds them all in memory)")
+    return n
+
+
 def monte_carlo_cases(args, table):
-    rng = np.random.default_rng(args.seed)
+    rng = np.random.default_rng(1 if args.seed is None else args.seed)
     draws = {name: log_normal(rng, nominal(table[name], args.fixed), cv, args.monte_carlo)
              for name, cv in args.scatter}
     return [{name: float(x[i]) for name, x in draws.items()} for i in range(args.monte_carlo)]
@@ -188,17 +320,45 @@ def grid_cases(vary):
     return [dict(zip(names, combo)) for combo in itertools.product(*[v for _, v in vary])]
 
 
+def unused_values(fixed, vary, first_case):
+    """The library's warnings (a value without effect, such as a material
+    beside a given k) for the fixed values with each varied value in turn
+    (the first of each varied name), or, in a Monte Carlo campaign, with
+    its first draw: what holds there holds for all its draws. A value the
+    library refuses is left to its case's row."""
+    checks = [[first_case]] if not vary else [[{name: v} for v in dict.fromkeys(column)] for name, column in vary]
+    found = []
+    for cases in checks:
+        for case in cases:
+            try:
+                why = model.warning(**{**fixed, **case})  # a draw replaces its nominal value
+            except ValueError:
+                continue
+            if why:
+                found.append(why)
+                break
+    return list(dict.fromkeys(found))
+
+
 def code(name, v):
     """A parameter's value as the library takes it (law=hertz -> 2)."""
     return model.WORDS[name].get(v, v) if name in model.WORDS and isinstance(v, str) else v
 
 
 def run_chunk(fixed, columns):
-    """One Dask task: the cases whose parameters are the arrays in columns
-    (fixed holds the rest) in one library call. Returns the RESULTS as
-    arrays, and {index: the library's message} of the cases it refused,
-    whose results are NaN or 0 (then the cases run one by one, to tell which)."""
-    fixed = {name: code(name, v) for name, v in fixed.items() if name not in columns}  # a varied name wins
+    """One Dask task: chunk_results() without the library's warnings, of
+    which the client has warned once already."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return chunk_results(fixed, columns)
+
+
+def chunk_results(fixed, columns):
+    """The cases whose parameters are the arrays in columns (fixed holds the
+    rest) in one library call. Returns the RESULTS as arrays, and {index:
+    the library's message} of the cases it refused, whose results are NaN
+    or 0 (then the cases run one by one, to tell which)."""
+    fixed = {name: code(name, v) for name, v in fixed.items() if name not in columns}  # draws replace the nominal
     arrays = {name: np.array([code(name, v) for v in column]) for name, column in columns.items()}
     n = len(next(iter(arrays.values())))
     try:
@@ -240,17 +400,28 @@ def chunks(cases, size):
         yield start, {name: [case[name] for case in part] for name in part[0]}
 
 
-def run(args, cases):
+def connect(args):
+    """(client, cluster): a Dask client of the scheduler at --scheduler
+    (cluster None), refused in one line when none answers there within
+    CONNECT_TIMEOUT, or of a local cluster of --workers processes."""
+    from dask.distributed import Client, LocalCluster
+    if not args.scheduler:
+        cluster = LocalCluster(n_workers=args.workers or WORKERS, threads_per_worker=1, processes=True,
+                               dashboard_address=None)
+        return Client(cluster), cluster
+    try:
+        return Client(args.scheduler, timeout=CONNECT_TIMEOUT), None
+    except ValueError as e:  # an address Dask cannot parse
+        raise ValueError(f"--scheduler {args.scheduler}: {e}") from None
+    except OSError:
+        raise ValueError(f"--scheduler {args.scheduler}: no Dask scheduler answered there within "
+                         f"{CONNECT_TIMEOUT:g} s") from None
+
+
+def run(args, client, cluster, cases):
     """All cases on Dask, in chunks of one library call each; returns the
     rows in case order and the wall time of the tasks."""
-    from dask.distributed import Client, LocalCluster, as_completed
-    if args.scheduler:
-        client = Client(args.scheduler)
-        cluster = None
-    else:
-        cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
-        client = Client(cluster)
+    from dask.distributed import as_completed
     # Before the clock starts, every worker imports the package and runs the
     # first case once: the library loaded, the path of a chunk and its
     # results taken (the first costs some 20 ms more than the next).
@@ -378,54 +549,99 @@ def title_of(args, rows):
     return ", ".join(parts)
 
 
-def main(argv=None, prog=None):
+def writable_folder(path):
+    """Refuses --out where the results could not be written: a path that is
+    no folder, a folder that cannot be created or written, or a result's
+    name taken by a folder. Nothing is created before the sweep has run."""
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"--out {path}: not a folder (it receives {', '.join(OUTPUTS)})")
+    existing = next(p for p in (path, *path.parents) if p.exists())
+    if not existing.is_dir():
+        raise ValueError(f"--out {path}: {existing} is not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise ValueError(f"--out {path}: {existing} is not writable")
+    for name in OUTPUTS:
+        if (path / name).is_dir():
+            raise ValueError(f"--out {path}: {path / name} is a folder")
+
+
+def arguments(argv, prog):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=VALUES",
-                        help=f"NAME=a:b:step or NAME=v1,v2,... (repeat for a grid; default height={DEFAULT_HEIGHTS})")
+                        help=f"NAME=a:b:step or NAME=v1,v2,... (repeat for a grid; default height={DEFAULT_HEIGHTS}); "
+                             "a material only with --set k=0")
     parser.add_argument("--set", dest="fixed", action="append", default=[], metavar="NAME=VALUE",
                         help=f"NAME=VALUE, a parameter held fixed (e.g. c=6080, law=hertz; default law: "
                              f"{default_law()}, the library's)")
-    parser.add_argument("--monte-carlo", type=int, default=0, metavar="N", help="N random impacts instead of a grid")
+    parser.add_argument("--monte-carlo", type=int, metavar="N",
+                        help=f"N random impacts instead of a grid (1 to {MAX_IMPACTS})")
     parser.add_argument("--scatter", action="append", default=[], metavar="NAME=S",
                         help="NAME=S: NAME log-normal in --monte-carlo, coefficient of variation S as a fraction "
                              "(0.05) or a percentage (5%%) (repeat)")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seed", type=int, help="--monte-carlo: the random generator's seed (default 1)")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
-    parser.add_argument("--workers", type=int, default=2, help="local cluster: worker processes (default 2)")
+    parser.add_argument("--workers", type=int,
+                        help=f"local cluster: worker processes (default {WORKERS}, at most the CPUs)")
     parser.add_argument("--batch", type=int, default=0,
                         help=f"impacts per Dask task, one library call (default: {TASKS_PER_WORKER} tasks a worker, "
                              f"or one while that leaves fewer than {CHUNK_MIN} impacts in a task)")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("sweep"),
                         help="folder for sweep.csv, sweep.png, sweep.json (default ./sweep)")
-    args = parser.parse_args(argv)
-    if args.monte_carlo and not args.scatter:
-        parser.error("--monte-carlo needs at least one --scatter NAME=S")
-    if args.workers < 1 or args.batch < 0:
-        parser.error("--workers must be >= 1 and --batch >= 1 (or 0, the default)")
-    if not args.vary and not args.monte_carlo:
-        args.vary = [f"height={DEFAULT_HEIGHTS}"]
+    return parser, parser.parse_args(argv)
+
+
+def prepared(args):
+    """The cases of the sweep the options ask for, every option checked
+    (args.vary, args.fixed and args.scatter turned into the values), and
+    the warnings of values without effect; ValueError for a bad option."""
+    table = parameter_table()
+    given = {option: named(table, option, texts) for option, texts in
+             (("--vary", args.vary), ("--set", args.fixed), ("--scatter", args.scatter))}
+    refuse_conflicts(args, given["--vary"], given["--set"], given["--scatter"])
+    if not given["--vary"] and args.monte_carlo is None:
+        given["--vary"] = named(table, "--vary", [f"height={DEFAULT_HEIGHTS}"])
+    args.vary = converted(table, "--vary", given["--vary"], values)
+    args.fixed = {"law": default_law(), **dict(converted(table, "--set", given["--set"], value))}
+    args.scatter = converted(table, "--scatter", given["--scatter"], scatter)
+    if args.monte_carlo is None:
+        grid_size(given["--vary"], args.vary)
+    writable_folder(args.out)
+    cases = monte_carlo_cases(args, table) if args.monte_carlo else grid_cases(args.vary)
+    return cases, unused_values(args.fixed, args.vary, cases[0])
+
+
+def main(argv=None, prog=None):
+    parser, args = arguments(argv, prog)
     try:
-        table = parameter_table()
-        args.vary = pairs(table, args.vary, values)
-        args.fixed = {"law": default_law(), **dict(pairs(table, args.fixed, value))}
-        args.scatter = pairs(table, args.scatter, scatter)
-        cases = monte_carlo_cases(args, table) if args.monte_carlo else grid_cases(args.vary)
+        cases, unused = prepared(args)
     except ValueError as e:
         parser.error(str(e))
-    rows, wall = run(args, cases)
+    for why in unused:
+        print(f"{parser.prog}: warning: {why}", file=sys.stderr)
+    try:
+        client, cluster = connect(args)
+    except ValueError as e:
+        parser.error(str(e))
+    rows, wall = run(args, client, cluster, cases)
+    monte_carlo = args.monte_carlo is not None
     failed = [r for r in rows if "error" in r]
-    args.out.mkdir(parents=True, exist_ok=True)
-    write_csv(args.out / "sweep.csv", rows)
     summary = dict(impacts=len(rows), failed=len(failed), wall_seconds=wall, impacts_per_second=len(rows) / wall,
-                   workers=None if args.scheduler else args.workers)
-    stats = statistics(rows) if args.monte_carlo else {}
-    atomic.write_text(args.out / "sweep.json", json.dumps(dict(summary, statistics=stats) if stats else summary) + "\n")
-    if args.monte_carlo and len(failed) < len(rows):
-        print_statistics(stats)
-        histograms(args.out / "sweep.png", rows, stats, title_of(args, rows))
-    elif not args.monte_carlo:
-        plot(args.out / "sweep.png", rows, [n for n, _ in args.vary], title_of(args, rows))
+                   workers=None if args.scheduler else args.workers or WORKERS)
+    stats = statistics(rows) if monte_carlo else {}
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        write_csv(args.out / "sweep.csv", rows)
+        atomic.write_text(args.out / "sweep.json",
+                          json.dumps(dict(summary, statistics=stats) if stats else summary) + "\n")
+        if monte_carlo and len(failed) < len(rows):
+            print_statistics(stats)
+            histograms(args.out / "sweep.png", rows, stats, title_of(args, rows))
+        elif not monte_carlo:
+            plot(args.out / "sweep.png", rows, [n for n, _ in args.vary], title_of(args, rows))
+    except OSError as e:
+        print(f"{parser.prog}: --out {args.out}: cannot write the results: {e.strerror or e}", file=sys.stderr)
+        return 2
     print(json.dumps(summary))
     for r in failed[:5]:
         print(f"failed: {r}", file=sys.stderr)
