@@ -1,0 +1,247 @@
+"""Issue 23's sweep defects (items 3, 7, 8, 12, 18): what `fraccontact
+sweep` decides before Dask starts is checked in-process, with the cluster
+replaced by a failure (an option that is refused must be refused before
+anything runs); the few behaviours that need a process or a cluster run
+one each."""
+
+import os
+import resource
+import subprocess
+import sys
+import time
+
+import pytest
+
+import fraccontact
+from fraccontact import sweep
+
+pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                                reason="Dask workers under a preloaded sanitizer runtime")
+
+
+class Started(Exception):
+    """The sweep got as far as starting its cluster."""
+
+    def __init__(self, args, cases):
+        super().__init__("the sweep started")
+        self.options, self.cases = args, cases
+
+
+@pytest.fixture
+def no_cluster(monkeypatch):
+    """sweep.main stops where it would start Dask, with the options and the
+    cases it would run."""
+    def started(args, *rest):
+        raise Started(args, rest[-1])
+    monkeypatch.setattr(sweep, "connect", lambda args: (None, None), raising=False)
+    monkeypatch.setattr(sweep, "run", started)
+
+
+def refusal(capsys, *args):
+    """The exit status and the error line of a sweep that must be refused."""
+    with pytest.raises(SystemExit) as e:
+        sweep.main(list(args))
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return e.value.code, err.strip().splitlines()[-1]
+
+
+def planned(tmp_path, *args):
+    """The options and cases a sweep would run."""
+    with pytest.raises(Started) as e:
+        sweep.main([*args, "--out", str(tmp_path / "out")])
+    return e.value.options, e.value.cases
+
+
+# ---------------------------------------------------------------- item 3
+
+
+def limited_sweep(*args):
+    """The command line in a process limited to 2 GiB of address space, so
+    that a grid built in memory fails there (MemoryError) instead of taking
+    the machine's memory."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+    return subprocess.run([sys.executable, "-m", "fraccontact", "sweep", *args], capture_output=True, text=True,
+                          preexec_fn=limit, timeout=120, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+
+
+def test_a_huge_grid_is_refused_before_it_is_built(tmp_path):
+    done = limited_sweep("--vary", "c=1:1e9:1", "--out", str(tmp_path / "out"))
+    assert done.returncode == 2, done.stderr[-2000:]
+    last = done.stderr.strip().splitlines()[-1]
+    assert "--vary c=1:1e9:1" in last and "1000000000 values" in last and str(sweep.MAX_IMPACTS) in last, last
+    assert "Traceback" not in done.stderr and not (tmp_path / "out").exists()
+
+
+def test_a_grid_whose_product_is_too_large_is_refused(no_cluster, tmp_path, capsys):
+    """1001 x 1000 values, each grid small: the product is refused."""
+    code, line = refusal(capsys, "--vary", "c=1:1001:1", "--vary", "k=1e8:1.999e8:1e5", "--out", str(tmp_path))
+    assert code == 2
+    assert "--vary c=1:1001:1 --vary k=1e8:1.999e8:1e5" in line and "1001 x 1000 = 1001000 impacts" in line, line
+
+
+def test_a_huge_monte_carlo_is_refused(no_cluster, tmp_path, capsys):
+    code, line = refusal(capsys, "--monte-carlo", "1000001", "--scatter", "c=0.1",
+                         "--out", str(tmp_path))
+    assert code == 2 and "--monte-carlo 1000001: the number of impacts must lie in [1, 1000000]" in line, line
+
+
+def readme_sweep_section():
+    readme = open(os.path.join(os.path.dirname(__file__), "..", "README.md")).read()
+    return " ".join(readme[readme.index("For campaigns, `fraccontact sweep`"):readme.index("## The solver")].split())
+
+
+def test_the_limits_are_stated_as_the_code_has_them():
+    limit = f"at most {sweep.MAX_IMPACTS:,} impacts".replace(",", " ")
+    text = " ".join(subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--help"], capture_output=True,
+                                   text=True, check=True).stdout.split())
+    assert limit in text and f"within {sweep.CONNECT_TIMEOUT} s" in text
+    assert limit in readme_sweep_section() and f"within {sweep.CONNECT_TIMEOUT} s" in readme_sweep_section()
+
+
+# ---------------------------------------------------------------- item 7
+
+
+def test_a_material_beside_k_is_warned_of_once(no_cluster, tmp_path, capsys):
+    """The library's own message, once on the client, for the first value
+    without effect."""
+    with pytest.raises(Started):
+        sweep.main(["--vary", "E-s=1e9,2e9", "--out", str(tmp_path)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].endswith(f"warning: {fraccontact.warning(E_s=1e9)}"), lines
+    assert "k = 3.299e+08 is given and wins" in lines[0]
+
+
+def test_a_material_with_k_zero_is_not_warned_of(no_cluster, tmp_path, capsys):
+    with pytest.raises(Started):
+        sweep.main(["--set", "k=0", "--vary", "E-s=1e9,2e9", "--out", str(tmp_path)])
+    assert capsys.readouterr().err == ""
+
+
+def test_help_and_readme_say_how_to_sweep_a_material():
+    text = " ".join(subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--help"], capture_output=True,
+                                   text=True, check=True).stdout.split())
+    assert "To sweep a material, --set k=0 --vary E_s=" in text
+    assert "to sweep a material, `--set k=0`" in readme_sweep_section()
+
+
+def test_the_warning_is_printed_once_by_a_real_sweep(tmp_path):
+    """A whole sweep on a local cluster: the client's one warning and no
+    other (the workers' library calls stay quiet), and the rows are the
+    same, as the warning says."""
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--vary", "E-s=1e9,2e9", "--set", "law=hertz",
+                           "--set", "dt_max=1e-6", "--workers", "1", "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stderr.count("has no effect") == 1, done.stderr
+    rows = (tmp_path / "sweep.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[1].split(",")[1:] == rows[2].split(",")[1:]
+
+
+# ---------------------------------------------------------------- item 8
+
+
+@pytest.mark.parametrize("spec, expected", [
+    ("tolerance=1e-12:4e-12:1.5e-12", [1e-12, 2.5e-12, 4e-12]),  # the issue's: ran 1e-12, 3e-12, 4e-12
+    ("gap0=0:4e-12:1.5e-12", [0.0, 1.5e-12, 3e-12]),  # the issue's: ran 0, 2e-12, 3e-12
+    ("R=1e-13:5e-13:1e-13", [1e-13, 2e-13, 3e-13, 4e-13, 5e-13]),
+])
+def test_small_grid_values_are_the_ones_asked_for(spec, expected, no_cluster, tmp_path):
+    """Each value exactly the double of the decimal start + i step (the
+    literals here), where rounding to 12 decimals merged or moved them."""
+    _, cases = planned(tmp_path, "--vary", spec)
+    name = spec.partition("=")[0]
+    assert [case[name] for case in cases] == expected
+
+
+@pytest.mark.parametrize("spec, expected", [
+    ("height=0.005:0.1:0.005", [float(f"{5 * i}e-3") for i in range(1, 21)]),  # stop on the grid: included
+    ("c=0.1:0.3:0.1", [0.1, 0.2, 0.3]),  # doubles would give 0.30000000000000004
+    ("c=0:1:0.3", [0.0, 0.3, 0.6, 0.9]),  # stop off the grid: the last value before it
+    ("c=2.5:2.5:1", [2.5]),
+    ("g1_nodes=10:40:10", [10, 20, 30, 40]),
+])
+def test_grid_rule(spec, expected, no_cluster, tmp_path):
+    """start + i step while it does not pass stop, exactly in decimal, each
+    then the nearest double; integers stay integers."""
+    _, cases = planned(tmp_path, "--vary", spec)
+    got = [case[spec.partition("=")[0]] for case in cases]
+    assert got == expected and [type(x) for x in got] == [type(x) for x in expected]
+
+
+def test_a_step_doubles_cannot_resolve_is_refused(no_cluster, tmp_path, capsys):
+    code, line = refusal(capsys, "--vary", "c=1:1.0000000000000002:1e-17", "--out", str(tmp_path))
+    assert code == 2 and "--vary c=1:1.0000000000000002:1e-17" in line and "repeat" in line, line
+
+
+# ---------------------------------------------------------------- item 12
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--set", "height=0.02"], "--set height=0.02 without --vary"),
+    (["--set", "v=1"], "--set v=1 without --vary"),
+    (["--monte-carlo", "5", "--scatter", "c=0.1", "--vary", "k=1e8,2e8"], "--vary k=1e8,2e8 with --monte-carlo"),
+    (["--scatter", "c=0.1"], "--scatter c=0.1 without --monte-carlo"),
+    (["--monte-carlo", "0", "--scatter", "c=0.1"], "--monte-carlo 0: the number of impacts must lie in [1,"),
+    (["--monte-carlo", "-3", "--scatter", "c=0.1"], "--monte-carlo -3"),
+    (["--set", "c=5000", "--vary", "c=3000,6080"], "--set c=5000 and --vary c=3000,6080: a parameter is either"),
+    (["--vary", "c=1,2", "--vary", "c=3"], "--vary c=1,2 and --vary c=3: c is given twice"),
+    (["--set", "c=1", "--set", "c=2"], "--set c=1 and --set c=2: c is given twice"),
+    (["--set", "v=1", "--vary", "height=0.01,0.02"], "--vary height=0.01,0.02 and --set v=1: height sets v"),
+    (["--seed", "3"], "--seed 3 without --monte-carlo"),
+    (["--monte-carlo", "5", "--scatter", "c=0.1", "--seed", "-1"], "--seed -1"),
+    (["--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers 2 with --scheduler"),
+    (["--workers", "100000"], "--workers 100000: a local cluster has 1 to"),
+    (["--batch", "-1"], "--batch -1"),
+    (["--vary", "c=1:inf:1"], "--vary c=1:inf:1: a grid's start, stop and step are finite"),
+])
+def test_options_that_would_be_ignored_or_contradict_are_refused(args, message, no_cluster, tmp_path, capsys):
+    code, line = refusal(capsys, *args, "--out", str(tmp_path / "out"))
+    assert code == 2 and message in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_set_height_with_a_grid_is_held(no_cluster, tmp_path):
+    """What --set height says, beside a grid of something else: every case
+    at that height."""
+    args, cases = planned(tmp_path, "--set", "height=0.02", "--vary", "c=3000,6080")
+    assert cases == [{"c": 3000.0}, {"c": 6080.0}] and args.fixed["height"] == 0.02
+
+
+# ---------------------------------------------------------------- item 18
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda tmp: "/dev/null", "--out /dev/null: not a folder"),
+    (lambda tmp: (tmp / "file").write_text("x") and str(tmp / "file"), "not a folder"),
+    (lambda tmp: (tmp / "file").write_text("x") and str(tmp / "file" / "sub"), "is not a folder"),
+    (lambda tmp: (tmp / "out" / "sweep.csv").mkdir(parents=True) or str(tmp / "out"), "sweep.csv is a folder"),
+])
+def test_an_out_that_cannot_receive_the_results_is_refused_first(make, message, no_cluster, tmp_path, capsys):
+    out = make(tmp_path)
+    code, line = refusal(capsys, "--vary", "c=3000,6080", "--out", out)
+    assert code == 2 and f"--out {out}" in line and message in line, line
+
+
+def test_a_bad_scheduler_address_is_refused(tmp_path, capsys):
+    code, line = refusal(capsys, "--scheduler", "localhost", "--out", str(tmp_path / "out"))
+    assert code == 2 and "--scheduler localhost:" in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys):
+    """Nothing listens on port 1: refused after the connect timeout (Dask's
+    default is 30 s), naming the address, nothing written."""
+    start = time.perf_counter()
+    code, line = refusal(capsys, "--scheduler", "tcp://127.0.0.1:1", "--vary", "c=3000,6080",
+                         "--out", str(tmp_path / "out"))
+    assert time.perf_counter() - start < sweep.CONNECT_TIMEOUT + 5
+    assert code == 2 and "--scheduler tcp://127.0.0.1:1: no Dask scheduler answered" in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_drift_the_readme_shows():
+    """The README's example of what adding doubles gives, beside the grid's 0.035 (test_grid_rule)."""
+    assert repr(0.005 + 6 * 0.005) == "0.034999999999999996" and "0.034999999999999996" in readme_sweep_section()
