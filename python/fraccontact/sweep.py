@@ -297,15 +297,14 @@ def cpus():
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-def grid_size(texts, vary):
-    """The number of impacts of the grid over the --vary values (texts as
-    given), refused beyond MAX_IMPACTS before the grid is built."""
+def refuse_large_grid(texts, vary):
+    """Refuses a grid over the --vary values (texts as given) of more than
+    MAX_IMPACTS impacts, before it is built."""
     n = math.prod(len(v) for _, v in vary)
     if n > MAX_IMPACTS:
         raise ValueError(f"{' '.join(f'--vary {text}' for _, _, text in texts)}: a grid of "
                          f"{' x '.join(str(len(v)) for _, v in vary)} = {n} impacts, more than the {MAX_IMPACTS} "
                          "a sweep runs (it holds them all in memory)")
-    return n
 
 
 def monte_carlo_cases(args, table):
@@ -605,7 +604,7 @@ def prepared(args):
     args.fixed = {"law": default_law(), **dict(converted(table, "--set", given["--set"], value))}
     args.scatter = converted(table, "--scatter", given["--scatter"], scatter)
     if args.monte_carlo is None:
-        grid_size(given["--vary"], args.vary)
+        refuse_large_grid(given["--vary"], args.vary)
     writable_folder(args.out)
     cases = monte_carlo_cases(args, table) if args.monte_carlo else grid_cases(args.vary)
     return cases, unused_values(args.fixed, args.vary, cases[0])
