@@ -92,10 +92,16 @@ def readme_sweep_section():
     return " ".join(readme[readme.index("For campaigns, `fraccontact sweep`"):readme.index("## The solver")].split())
 
 
-def test_the_limits_are_stated_as_the_code_has_them():
+def help_text(capsys):
+    with pytest.raises(SystemExit) as e:
+        sweep.main(["--help"])
+    assert e.value.code == 0
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_the_limits_are_stated_as_the_code_has_them(capsys):
     limit = f"at most {sweep.MAX_IMPACTS:,} impacts".replace(",", " ")
-    text = " ".join(subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--help"], capture_output=True,
-                                   text=True, check=True).stdout.split())
+    text = help_text(capsys)
     assert limit in text and f"within {sweep.CONNECT_TIMEOUT} s" in text
     assert limit in readme_sweep_section() and f"within {sweep.CONNECT_TIMEOUT} s" in readme_sweep_section()
 
@@ -120,10 +126,8 @@ def test_a_material_with_k_zero_is_not_warned_of(no_cluster, tmp_path, capsys):
     assert capsys.readouterr().err == ""
 
 
-def test_help_and_readme_say_how_to_sweep_a_material():
-    text = " ".join(subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--help"], capture_output=True,
-                                   text=True, check=True).stdout.split())
-    assert "To sweep a material, --set k=0 --vary E_s=" in text
+def test_help_and_readme_say_how_to_sweep_a_material(capsys):
+    assert "To sweep a material, --set k=0 --vary E_s=" in help_text(capsys)
     assert "to sweep a material, `--set k=0`" in readme_sweep_section()
 
 
@@ -218,7 +222,7 @@ def test_a_set_height_with_a_grid_is_held(no_cluster, tmp_path):
     (lambda tmp: (tmp / "file").write_text("x") and str(tmp / "file"), "not a folder"),
     (lambda tmp: (tmp / "file").write_text("x") and str(tmp / "file" / "sub"), "is not a folder"),
     (lambda tmp: (tmp / "out" / "sweep.csv").mkdir(parents=True) or str(tmp / "out"), "sweep.csv is a folder"),
-])
+], ids=["dev-null", "a-file", "under-a-file", "a-result-is-a-folder"])
 def test_an_out_that_cannot_receive_the_results_is_refused_first(make, message, no_cluster, tmp_path, capsys):
     out = make(tmp_path)
     code, line = refusal(capsys, "--vary", "c=3000,6080", "--out", out)
@@ -231,9 +235,11 @@ def test_a_bad_scheduler_address_is_refused(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys):
+def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys, monkeypatch):
     """Nothing listens on port 1: refused after the connect timeout (Dask's
-    default is 30 s), naming the address, nothing written."""
+    default is 30 s; 1 s here, to keep the test short), naming the address,
+    nothing written."""
+    monkeypatch.setattr(sweep, "CONNECT_TIMEOUT", 1, raising=False)
     start = time.perf_counter()
     code, line = refusal(capsys, "--scheduler", "tcp://127.0.0.1:1", "--vary", "c=3000,6080",
                          "--out", str(tmp_path / "out"))
