@@ -385,3 +385,65 @@ def test_the_examples_are_made_from_the_readmes_constants():
     r = fit.fit_curve(t, F, made.M, made.speed(0.020))
     for name, truth in (("k", made.K), ("c", made.C), ("t0", made.TRIGGER)):
         assert abs(r[name] - truth) < 2 * r[f"sigma_{name}"], (name, r[name], truth, r[f"sigma_{name}"])
+
+
+# The README's printed examples and the paper's Table 1.
+
+def output_block_after(text, lead):
+    """The plain ``` block that follows the line containing lead."""
+    after = text.split(lead, 1)[1]
+    return re.search(r"```\n(.*?)```", after, re.S).group(1).splitlines()
+
+
+def shown_in(shown, printed):
+    """The shown lines missing from printed (each shown line, its trailing '...' cut, starts a printed line)."""
+    printed = [" ".join(line.split()) for line in printed]
+    return [line for line in shown
+            if not any(p.startswith(" ".join(line.rstrip(". ").split()).rstrip(",")) for p in printed)]
+
+
+def test_the_run_command_prints_the_readme_table(tmp_path):
+    shown = output_block_after(section("Two commands"), "`scripts/run` prints the figures")
+    run = subprocess.run([sys.executable, "-m", "fraccontact", "run", "--out", str(tmp_path), "--fmu", str(FMU)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert not shown_in(shown, run.stdout.splitlines()), run.stdout
+
+
+def test_the_solver_prints_the_readme_table():
+    command = "build/fraccontact-solve --g 9.81 --impacts 3"
+    shown = output_block_after(section("The solver: fraccontact-solve"), f"`{command}`, prints:")
+    run = subprocess.run([SOLVE, *command.split()[1:]], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert not shown_in(shown, run.stdout.splitlines()), run.stdout
+
+
+def solve_json(*options):
+    run = subprocess.run([SOLVE, *options, "--json", "--quiet"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout)
+
+
+def test_the_defaults_against_the_papers_table_1():
+    """The model's h20 figures against the paper's 1004 N and 0.59, law 1
+    against GSL's solution of the same ODE, the paper's central scheme, and
+    k from the materials."""
+    text = " ".join(section("The defaults against the paper's Table 1").split())
+    F_peak, eps = re.search(r"the model gives \*\*F_peak = (\S+) N and eps = (\S+)\*\*", text).groups()
+    more, less = re.search(r"\*\*\+(\S+) % in peak force, −(\S+) in restitution\*\*", text).groups()
+    r = fraccontact.impact()
+    assert_figure(r.F_peak, F_peak, "F_peak")
+    assert_figure(r.eps, eps, "eps")
+    assert_figure(100 * (r.F_peak / 1004 - 1), more, "+% in F_peak")
+    assert_figure(0.59 - r.eps, less, "-eps")
+    g1_F, g1_eps = re.search(r"differs from it by (\S+) \(F_peak\) to (\S+) \(eps\)", text).groups()
+    reference = solve_json("--reference")
+    assert_figure(abs(r.F_peak / reference["F_peak"] - 1), g1_F, "law 1's F_peak")
+    assert_figure(abs(r.eps / reference["eps"] - 1), g1_eps, "law 1's eps")
+    fine, fine_dt, coarse, coarse_dt = re.search(r"(\S+) N at Δt = (\S+) s, (\S+) N at (\S+) s", text).groups()
+    for F, dt in ((fine, fine_dt), (coarse, coarse_dt)):
+        assert_figure(solve_json("--scheme", "central", "--dt-max", dt)["F_peak"], F, f"central at {dt}")
+    k, below = re.search(r"the formula gives `k` = (\S+), (\S+) % below", text).groups()
+    derived = fraccontact.impact(k=0.0).k
+    assert_figure(derived, k, "k from the materials")
+    assert_figure(100 * (1 - derived / 3.299e8), below, "% below 3.299e8")
