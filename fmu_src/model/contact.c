@@ -1668,9 +1668,12 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
             continue;
         }
         /* In contact: equal steps of at most dt_max over the rest, rounding
-         * n up but forgiving the last few ulp (H = n dt_max gives n steps,
-         * not n + 1 with a sliver), until the contact ends. */
-        n = fmax(1.0, ceil(remaining / cm->p.dt_max * (1.0 - 1e-12)));
+         * n up but forgiving the last few ulp of the step and of the clock
+         * (H = n dt_max gives n steps, not n + 1 with a sliver, also when a
+         * master computes H as t_next - t, which errs by an ulp of t), until
+         * the contact ends. */
+        n = fmax(1.0, ceil((remaining - 4.0 * DBL_EPSILON * fabs(cm->s.t + remaining)) / cm->p.dt_max *
+                           (1.0 - 1e-12)));
         h = remaining / n;
         for (i = 0; i < n && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
             int status = internal_step(cm, h, &impulse, stop_at);
