@@ -38,6 +38,7 @@ import numpy as np
 from scipy.optimize import brentq, least_squares
 
 from . import hertz, model
+from .options import OneLineParser, finite, positive
 
 MIN_ROWS = 10           # three parameters and enough residuals left to estimate the noise
 MIN_PEAK_SAMPLES = 5    # samples above half the peak force: fewer cannot pin k, c and t0 apart
@@ -1138,25 +1139,6 @@ def family_report(result):
 # The command line.
 
 
-def finite(text):
-    """argparse type: a finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a number")
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text} is not a finite number")
-    return value
-
-
-def positive(text):
-    """argparse type: a finite number > 0."""
-    value = finite(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text} is not positive")
-    return value
-
-
 def order(text):
     """argparse type: a springpot order, 0 < alpha <= 1."""
     value = finite(text)
@@ -1187,13 +1169,6 @@ def plot_file(text):
         raise argparse.ArgumentTypeError(f"{text}: unknown image type '{path.suffix}'; use one of "
                                          f"{', '.join(sorted(formats))}")
     return path
-
-
-class OneLineParser(argparse.ArgumentParser):
-    """Errors as one line on stderr, exit status 2."""
-
-    def error(self, message):
-        self.exit(2, f"fit: {message} (see --help)\n")
 
 
 def default_help(name, what):
@@ -1352,13 +1327,13 @@ def main(argv=None, prog=None):
                     warnings.append(f"chi-square {result['chi2']:.3g} for {result['dof']} degrees of freedom is above "
                                     "its 99.9 % quantile: the model misses the data or the sigmas are too small")
     except BadInput as e:
-        print(f"fit: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 2
     except Unreachable as e:
-        print(f"fit: not reachable by this model: {e}", file=sys.stderr)
+        print(f"{parser.prog}: not reachable by this model: {e}", file=sys.stderr)
         return 2
     except RuntimeError as e:
-        print(f"fit: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 1
     result.setdefault("m", args.m)
     result.setdefault("law", args.law)
@@ -1371,7 +1346,7 @@ def main(argv=None, prog=None):
         for mb in result["family"]["members"]:
             mb.pop("x", None)
     for w in warnings:
-        print(f"fit: warning: {w}", file=sys.stderr)
+        print(f"{parser.prog}: warning: {w}", file=sys.stderr)
     if args.json:
         print(json.dumps(result))
     else:
