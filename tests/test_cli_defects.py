@@ -5,6 +5,7 @@ nothing left on disk; a missing module names the extra that installs it;
 a reader that closes the pipe early gets no traceback; an impact that has
 not ended reports no eps; fit's hints follow what is actually wrong."""
 
+import argparse
 import json
 import math
 import os
@@ -73,10 +74,19 @@ def test_run_refuses_a_bad_option_before_the_run(command, monkeypatch, tmp_path,
     assert "raise --stop-time" not in err and not (tmp_path / "new").exists()
 
 
-def test_run_bounds_the_rows_at_what_it_can_hold():
-    """The bound is stated and is the one enforced: a million rows of fmpy's
-    tuples (some 400 bytes each) fit in memory, which 1e9 rows do not."""
-    assert h20_drop.MAX_ROWS == 1_000_000
+@pytest.mark.parametrize("stop_time, refused", [(1.0, False), (1.0 + 2e-6, True)])
+def test_run_bounds_the_rows_where_its_help_says(command, stop_time, refused):
+    """The bound the help states is the one enforced, at its edge: a million
+    rows of fmpy's tuples, some 400 bytes each, fit in memory."""
+    status, out, err = command("run", "--help")
+    assert status == 0 and "at most 1e+06 rows: stop time / interval" in " ".join(out.split())
+    parser = h20_drop.reports.parser("fraccontact run", "")
+    args = argparse.Namespace(fmu=CONTACT, stop_time=stop_time, output_interval=1e-6)
+    if refused:
+        with pytest.raises(SystemExit):
+            h20_drop.check(parser, args)
+    else:
+        h20_drop.check(parser, args)
 
 
 def test_run_says_the_fmus_refusal_in_one_line(command, tmp_path):
