@@ -156,9 +156,9 @@ def test_cosim_spares_libcosim_a_value_the_fmu_refuses():
     """libcosim ends the process on an FMU's error (C++ terminate): the
     values are tried first, and the refusal is the same one line. In a
     process of its own, for libcosim would end pytest's."""
-    done = subprocess.run([sys.executable, "-m", "fraccontact", "cosim", "--gravity", "1e300", "--contact-knows-gravity",
-                           "--order", "libcosim", "--coupling", "predictive"], capture_output=True, text=True,
-                          timeout=300)
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "cosim", "--gravity", "1e300",
+                           "--contact-knows-gravity", "--order", "libcosim", "--coupling", "predictive"],
+                          capture_output=True, text=True, timeout=300)
     assert done.returncode == 2 and done.stdout == ""
     one_line(done.stderr, "the contact FMU refused its start values: g = 1e+300 is invalid")
 
@@ -293,7 +293,8 @@ def test_the_package_ships_the_scene_its_reports_run():
     assert "add_subdirectory(ssp)" in package
     installed = re.search(r'install\(FILES (.*?) DESTINATION fraccontact\)', package).group(1)
     assert "${SSP_FILE}" in installed and "${FMU_FILE}" in installed
-    assert 'set(SSP_FILE "${CMAKE_BINARY_DIR}/drop_test.ssp" PARENT_SCOPE)' in (ROOT / "ssp" / "CMakeLists.txt").read_text()
+    ssp_cmake = (ROOT / "ssp" / "CMakeLists.txt").read_text()
+    assert 'set(SSP_FILE "${CMAKE_BINARY_DIR}/drop_test.ssp" PARENT_SCOPE)' in ssp_cmake
     assert PYPROJECT["tool"]["scikit-build"]["wheel"]["packages"] == ["python/fraccontact"]
 
 

@@ -43,7 +43,8 @@ ORDERS = ("jacobi", "gauss-seidel")
 # settings for it: its proxy striker's mass and its parameter coupling.
 FORCE = {"zoh": "F", "mass-aware": "F_avg", "predictive": "F_avg_next"}
 MONOLITHIC_STEP = 1e-5  # the reference's communication step (its internal steps are dt_max's whatever it is)
-# A communication step costs some 25 us in fmpy: a run of more is refused (the command's and its reference's).
+# The communication steps a run may take (the command's, and its reference's): fmpy's calls cost some
+# microseconds each, so this bounds a run to minutes.
 MAX_STEPS = 1_000_000
 # The variables this module reads and sets in each FMU.
 CONTACT_VARIABLES = ("law", "scene", "v", "m", "g", "coupling", "F", "F_avg", "F_avg_next", "F_peak", "E_diss",

@@ -50,7 +50,7 @@ IMPULSE_RANGE = (1 / 3, 3)  # of m v; a rebound gives 1 + eps, between 1 and 2
 UNIT_FACTORS = ((1e3, "column 1 (time [s])", "are the times in milliseconds? They must be seconds"),
                 (1e6, "column 1 (time [s])", "are the times in microseconds? They must be seconds"),
                 (1e-3, "column 2 (force [N])", "are the forces in kN? They must be newtons"))
-END_FRACTION = 0.1      # a whole contact starts and ends near F = 0: a first or last force above 10 % of the peak is cut
+END_FRACTION = 0.1      # a whole contact starts and ends near F = 0: an end above 10 % of the peak is cut off
 WHITENESS_SIGMAS = 3    # lag-1 autocorrelation of white residuals is about N(0, 1/n)
 STEPS_PER_CONTACT = 4000   # the model's internal step: the Hertz contact time / 4000 (F_peak to ~1e-7)
 ROWS_PER_CONTACT = 2000    # the model's force curve: a row every contact time / 2000, interpolated linearly

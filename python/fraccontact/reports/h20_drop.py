@@ -20,8 +20,8 @@ from ..options import positive  # noqa: E402
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
 OUTPUTS = ["F", "x", "x1", "x2", "v_striker", "eps", "F_peak", "E_diss", "contact"]
-# fmpy holds a row as a tuple of Python floats until the end of a run (about 400 bytes), then the CSV
-# writes it: a million rows are some 400 MB and a minute; more are refused before the run.
+# fmpy holds every row as a tuple of Python floats until the end of a run, and the CSV writes them all:
+# the rows a run may make (stop time / output interval), within a desktop's memory and a few minutes.
 MAX_ROWS = 1_000_000
 
 
