@@ -4,6 +4,7 @@ names (--m, --v, --c, --E-s, --t-end: '-' for '_')."""
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 
@@ -19,6 +20,8 @@ COMMANDS = {
 }
 MODULES = {"run": "fraccontact.reports.h20_drop", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
            "cosim": "fraccontact.cosim"}
+# The extra of pyproject.toml's optional-dependencies that installs what each command imports.
+EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "report": "reports"}
 
 
 def report_names():
@@ -32,11 +35,22 @@ def parser():
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=f"commands:\n{commands}\nreports: {', '.join(report_names())}")
     p.add_argument("command", choices=COMMANDS, metavar="COMMAND", help="one of " + ", ".join(COMMANDS))
-    p.add_argument("options", nargs=argparse.REMAINDER, help="the command's options (COMMAND --help)")
+    options = p.add_argument("options", nargs=argparse.REMAINDER, help="the command's options (COMMAND --help)")
+    options.required = False  # argparse calls a REMAINDER positional required, yet it may be empty
     return p
 
 
-def main(argv=None):
+def missing_module_hint(prog, command, error):
+    """One line for a module the command needs that is not installed (a
+    plain `pip install .` installs numpy alone); None when the missing
+    module is the package's own (a fault of the package, not the install)."""
+    name = (error.name or "").partition(".")[0]
+    if not name or name == __package__:
+        return None
+    return f"{prog} needs {name}, which is not installed: pip install 'fraccontact[{EXTRAS[command]}]'"
+
+
+def run(argv):
     args = parser().parse_args(argv)
     prog = f"fraccontact {args.command}"
     options = args.options
@@ -52,4 +66,23 @@ def main(argv=None):
         module, prog, options = f"{reports.__name__}.{options[0]}", f"{prog} {options[0]}", options[1:]
     else:
         module = MODULES[args.command]
-    return importlib.import_module(module).main(options, prog=prog) or 0
+    try:
+        return importlib.import_module(module).main(options, prog=prog) or 0
+    except ModuleNotFoundError as e:
+        hint = missing_module_hint(prog, args.command, e)
+        if hint is None:
+            raise
+        print(hint, file=sys.stderr)
+        return 2
+
+
+def main(argv=None):
+    try:
+        status = run(argv)
+        sys.stdout.flush()  # here, where a closed pipe can still be caught, not at the interpreter's exit
+        return status
+    except BrokenPipeError:
+        # The reader has gone (fraccontact fit ... | head -3): stop quietly. stdout goes to /dev/null so that
+        # Python's own flush at exit does not meet the closed pipe again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1

@@ -26,11 +26,14 @@ Used by the cosim_study report and tests/test_cosim.py; also a command:
 import argparse
 import json
 import pathlib
+import sys
 
 from fmpy import read_model_description
+from fmpy.fmi1 import FMICallException
 
 from . import fmu_path, model
-from .fmu import Slave, unpacked
+from .fmu import Slave, description, unpacked
+from .options import OneLineParser, finite, positive
 from .scipy_contact import solve_drop
 
 M, V0 = model.defaults()["m"], model.defaults()["v"]  # the h20 drop test's striker
@@ -39,6 +42,18 @@ ORDERS = ("jacobi", "gauss-seidel")
 # What each coupling connects to the striker's force, and the contact's
 # settings for it: its proxy striker's mass and its parameter coupling.
 FORCE = {"zoh": "F", "mass-aware": "F_avg", "predictive": "F_avg_next"}
+MONOLITHIC_STEP = 1e-5  # the reference's communication step (its internal steps are dt_max's whatever it is)
+# The communication steps a run may take (the command's, and its reference's): fmpy's calls cost some
+# microseconds each, so this bounds a run to minutes.
+MAX_STEPS = 1_000_000
+# The variables this module reads and sets in each FMU.
+CONTACT_VARIABLES = ("law", "scene", "v", "m", "g", "coupling", "F", "F_avg", "F_avg_next", "F_peak", "E_diss",
+                     "eps", "v_striker", "x")
+STRIKER_VARIABLES = ("m", "v0", "g", "k_s", "F", "v", "x")
+
+
+class Refused(Exception):
+    """An FMU refused a value or a step: its own message, and who refused."""
 
 
 def contact_values(coupling, g_contact=0.0):
@@ -48,6 +63,11 @@ def contact_values(coupling, g_contact=0.0):
     if coupling == "predictive":
         values["coupling"] = 2
     return values
+
+
+def striker_values(g=0.0, k_s=0.0):
+    """The striker FMU's values: the h20 striker under gravity g, held by a spring k_s."""
+    return {"m": M, "v0": V0, "g": g, "k_s": k_s}
 
 
 def check_order(coupling, order):
@@ -67,32 +87,69 @@ def energy_error(v_end, E_diss, x_end=0.0, g=0.0, k_s=0.0):
 
 class Unit(Slave):
     """One FMU instance of a co-simulation, named, its values set in
-    initialization mode; get() reads several reals at once."""
+    initialization mode; get() reads several reals at once. A call the FMU
+    refuses raises Refused with the FMU's message."""
 
     def __init__(self, path, name, values):
         md, folder = unpacked(str(pathlib.Path(path).resolve()))
         super().__init__(md, folder, start=False, instance_name=name)
+        self.name = name
         self.enter()
         self.set(**values)
-        self.fmu.exitInitializationMode()
+        try:
+            self.fmu.exitInitializationMode()
+        except FMICallException as e:
+            raise self.refused("its start values", e) from None
+
+    def refused(self, what, error):
+        return Refused(f"the {self.name} FMU refused {what}: {self.recent_error() or error}")
+
+    def set(self, **values):
+        try:
+            super().set(**values)
+        except FMICallException as e:
+            raise self.refused(", ".join(f"{name} = {value:g}" for name, value in values.items()), e) from None
+
+    def do_step(self, t, H):
+        try:
+            self.fmu.doStep(t, H)
+        except FMICallException as e:
+            raise self.refused(f"the step of {H:g} s at t = {t:g} s", e) from None
 
     def get(self, *names):
         values = self.fmu.getReal([self.variables[n].valueReference for n in names])
         return values[0] if len(names) == 1 else values
 
 
-def monolithic(contact_fmu, t_end=3e-3, H=1e-5, law=2, g=0.0):
+def finished(eps_contact):
+    """Whether an impact has ended: the contact FMU's eps is that of the last
+    finished impact, 0 before one ends."""
+    return eps_contact > 0
+
+
+def monolithic(contact_fmu, t_end=3e-3, H=MONOLITHIC_STEP, law=2, g=0.0):
     """The reference: the contact FMU's own drop test, same model and dt_max
     (the closed-form Hertz law unless law says otherwise), its striker under
-    the acceleration g; v_end is its velocity at t_end."""
+    the acceleration g; v_end is its velocity at t_end, eps None before an
+    impact has ended."""
     c = Unit(contact_fmu, "monolithic", {"law": law, "v": V0, "m": M, "g": g})
     t = 0.0
     while t < t_end - 1e-15:
-        c.fmu.doStep(t, H)
+        c.do_step(t, H)
         t += H
     F_peak, eps, E_diss, v, x = c.get("F_peak", "eps", "E_diss", "v_striker", "x")
     c.free()
-    return dict(F_peak=F_peak, eps=eps, E_diss=E_diss, v_end=v, energy_error=energy_error(v, E_diss, x, g))
+    return dict(F_peak=F_peak, eps=eps if finished(eps) else None, E_diss=E_diss, v_end=v,
+                energy_error=energy_error(v, E_diss, x, g))
+
+
+def result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s):
+    """A co-simulation's figures; eps (from the striker's final velocity)
+    and eps_contact are None while no impact has ended: a striker still in
+    contact has no restitution to report."""
+    ended = finished(eps_contact)
+    return dict(F_peak=F_peak, eps=-v_end / V0 if ended else None, eps_contact=eps_contact if ended else None,
+                impact_ended=ended, E_diss=E_diss, v_end=v_end, energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
 
 
 def spring_reference(k_s):
@@ -110,10 +167,11 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     the contact's proxy striker knows as g_contact) and held by a spring k_s
     at its start (which the contact does not know); returns F_peak, eps (from
     the striker's final velocity), eps_contact (the contact's own, at the
-    separation), the energy error and, with trace, the series."""
+    separation; both None before an impact has ended), the energy error and,
+    with trace, the series."""
     check_order(coupling, order)
     contact = Unit(contact_fmu, "contact", contact_values(coupling, g_contact))
-    striker = Unit(striker_fmu, "striker", {"m": M, "v0": V0, "g": g, "k_s": k_s})
+    striker = Unit(striker_fmu, "striker", striker_values(g, k_s))
     force = FORCE[coupling]
     F_held = contact.get(force)  # before the first step: F_avg_next is F, 0 at the start
     series = []
@@ -123,13 +181,13 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
         contact.set(v=v)
         if order == "jacobi":
             striker.set(F=F_held)
-            striker.fmu.doStep(t, H)
-            contact.fmu.doStep(t, H)
+            striker.do_step(t, H)
+            contact.do_step(t, H)
             F_held = contact.get(force)
         else:
-            contact.fmu.doStep(t, H)
+            contact.do_step(t, H)
             striker.set(F=contact.get(force))
-            striker.fmu.doStep(t, H)
+            striker.do_step(t, H)
         n += 1
         t = n * H
         if trace:
@@ -138,11 +196,10 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     F_peak, E_diss, eps_contact = contact.get("F_peak", "E_diss", "eps")
     contact.free()
     striker.free()
-    result = dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
-                  energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
+    figures = result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s)
     if trace:
-        result["series"] = series
-    return result
+        figures["series"] = series
+    return figures
 
 
 def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0, g_contact=0.0, k_s=0.0):
@@ -153,6 +210,9 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
+    # libcosim ends the process on an FMU's error in its initialization: the values are tried in fmpy first.
+    Unit(contact_fmu, "contact", contact_values(coupling, g_contact)).free()
+    Unit(striker_fmu, "striker", striker_values(g, k_s)).free()
     log_output_level(CosimLogLevel.ERROR)
     cvr = {v.name: v.valueReference for v in read_model_description(str(contact_fmu)).modelVariables}
     svr = {v.name: v.valueReference for v in read_model_description(str(striker_fmu)).modelVariables}
@@ -164,19 +224,17 @@ def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0
             ex.integer_initial_value(c, cvr[name], value)
         else:
             ex.real_initial_value(c, cvr[name], value)
-    ex.real_initial_value(s, svr["m"], M)
-    ex.real_initial_value(s, svr["v0"], V0)
-    ex.real_initial_value(s, svr["g"], g)
-    ex.real_initial_value(s, svr["k_s"], k_s)
+    for name, value in striker_values(g, k_s).items():
+        ex.real_initial_value(s, svr[name], value)
     ex.connect_real_variables(s, svr["v"], c, cvr["v"])
     ex.connect_real_variables(c, cvr[FORCE[coupling]], s, svr["F"])
     observer = CosimObserver.create_last_value()
     ex.add_observer(observer)
-    ex.simulate_until(target_time=round(t_end * 1e9))
+    if not ex.simulate_until(target_time=round(t_end * 1e9)):
+        raise Refused(f"libcosim stopped the run before t = {t_end:g} s: an FMU refused a value or a step")
     F_peak, E_diss, eps_contact = observer.last_real_values(c, [cvr["F_peak"], cvr["E_diss"], cvr["eps"]])
     v_end, x_end = observer.last_real_values(s, [svr["v"], svr["x"]])
-    return dict(F_peak=F_peak, eps=-v_end / V0, eps_contact=eps_contact, E_diss=E_diss, v_end=v_end,
-                energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
+    return result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s)
 
 
 def add_fmu_options(parser):
@@ -188,32 +246,51 @@ def add_fmu_options(parser):
 
 
 def fmu_paths(parser, args):
-    """args.contact and args.striker, the defaults filled in; a missing FMU is a usage error."""
+    """args.contact and args.striker, the defaults filled in; a missing FMU,
+    or one that is not the contact or the striker FMU, is a usage error."""
     try:
-        return args.contact or fmu_path(), args.striker or fmu_path("striker")
+        contact, striker = args.contact or fmu_path(), args.striker or fmu_path("striker")
     except FileNotFoundError as e:
         parser.error(str(e))
+    for option, path, names, what in (("--contact", contact, CONTACT_VARIABLES, "the contact FMU (fraccontact.fmu)"),
+                                      ("--striker", striker, STRIKER_VARIABLES, "the striker FMU (striker.fmu)")):
+        try:
+            description(path, names, fmi2=True)
+        except ValueError as e:
+            parser.error(f"{option} {path}: {e}; expected {what}")
+    return contact, striker
+
+
+def check_times(parser, args):
+    """--step and --t-end together: a step within the run, and at most
+    MAX_STEPS communication steps for the run and its monolithic reference."""
+    if args.step > args.t_end:
+        parser.error(f"--step {args.step:g} s is longer than --t-end {args.t_end:g} s")
+    steps = args.t_end / min(args.step, MONOLITHIC_STEP)
+    if steps > MAX_STEPS:
+        parser.error(f"--t-end {args.t_end:g} s in steps of {min(args.step, MONOLITHIC_STEP):g} s (--step, or the "
+                     f"reference's {MONOLITHIC_STEP:g} s) is {steps:.3g} steps; at most {MAX_STEPS:.0e}")
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = OneLineParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_fmu_options(parser)
-    parser.add_argument("--step", type=float, default=1e-5, help="communication step [s] (default 1e-5)")
+    parser.add_argument("--step", type=positive, default=1e-5, help="communication step [s] (default 1e-5)")
     parser.add_argument("--coupling", choices=COUPLINGS, default="mass-aware")
     parser.add_argument("--order", choices=ORDERS + ("libcosim",), default="gauss-seidel",
                         help="master order, or libcosim to run the scene in libcosim (Jacobi)")
-    parser.add_argument("--t-end", type=float, default=3e-3, help="simulated time [s] (default 3e-3)")
-    parser.add_argument("--gravity", type=float, default=0.0,
+    parser.add_argument("--t-end", type=positive, default=3e-3,
+                        help=f"simulated time [s] (default 3e-3; at most {MAX_STEPS:.0e} steps of --step, and of "
+                             f"{MONOLITHIC_STEP:g} s for the reference)")
+    parser.add_argument("--gravity", type=finite, default=0.0,
                         help="the striker's gravity [m/s^2] (default 0), an external force on it")
     parser.add_argument("--contact-knows-gravity", action="store_true",
                         help="give the contact FMU's proxy striker the same gravity (its parameter g)")
-    parser.add_argument("--k-s", type=float, default=0.0,
+    parser.add_argument("--k-s", type=finite, default=0.0,
                         help="stiffness of a spring holding the striker where the contact begins [N/m] (default 0), "
                              "an external force the contact does not know; judged against scipy's solution")
     args = parser.parse_args(argv)
-    if not args.step > 0:
-        parser.error("--step must be positive")
+    check_times(parser, args)
     if not args.k_s >= 0:
         parser.error(f"--k-s must be 0 or positive, not {args.k_s:g}")
     if args.k_s > 0 and args.gravity != 0:
@@ -222,17 +299,23 @@ def main(argv=None, prog=None):
         parser.error("--coupling predictive (F_avg_next) is for Jacobi masters: --order jacobi or libcosim")
     args.contact, args.striker = fmu_paths(parser, args)
     forces = dict(g=args.gravity, g_contact=args.gravity if args.contact_knows_gravity else 0.0, k_s=args.k_s)
-    if args.order == "libcosim":
-        r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end, **forces)
-    else:
-        r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end, **forces)
-    if args.k_s > 0:  # the spring keeps acting after the separation: eps is the contact's, at the separation
-        ref = spring_reference(args.k_s)
-        print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
-                              eps_error=r["eps_contact"] - ref["eps"], reference=ref)))
-        return
-    ref = monolithic(args.contact, g=args.gravity)
-    # eps of both from the striker's velocity at t_end (the same as at the separation without gravity)
-    print(json.dumps(dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1, eps_error=r["eps"] + ref["v_end"] / V0,
-                          monolithic=ref)))
+    try:
+        if args.order == "libcosim":
+            r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end, **forces)
+        else:
+            r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end, **forces)
+        if args.k_s > 0:  # the spring keeps acting after the separation: eps is the contact's, at the separation
+            ref = spring_reference(args.k_s)
+            figures = dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
+                           eps_error=None if r["eps"] is None else r["eps_contact"] - ref["eps"], reference=ref)
+        else:
+            ref = monolithic(args.contact, t_end=args.t_end, g=args.gravity)
+            # eps of both from the striker's velocity at t_end (the same as at the separation without gravity)
+            figures = dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
+                           eps_error=None if r["eps"] is None else r["eps"] + ref["v_end"] / V0, monolithic=ref)
+    except Refused as e:
+        parser.error(str(e))
+    if not r["impact_ended"]:
+        print(f"{parser.prog}: the impact has not ended by --t-end {args.t_end:g} s: eps is null", file=sys.stderr)
+    print(json.dumps(figures))
 

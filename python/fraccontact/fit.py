@@ -38,12 +38,19 @@ import numpy as np
 from scipy.optimize import brentq, least_squares
 
 from . import hertz, model
+from .options import OneLineParser, finite, positive
 
 MIN_ROWS = 10           # three parameters and enough residuals left to estimate the noise
 MIN_PEAK_SAMPLES = 5    # samples above half the peak force: fewer cannot pin k, c and t0 apart
 SPIKE_FACTOR = 5        # no sample of a smooth, resolved pulse is 5 times both its neighbours
 SPIKE_NOISE_LEVELS = 10  # ... nor does Gaussian noise reach 5 x 10 = 50 standard deviations
 IMPULSE_RANGE = (1 / 3, 3)  # of m v; a rebound gives 1 + eps, between 1 and 2
+# An impulse off by a unit's factor (IMPULSE_RANGE times it) is blamed on that unit: times in ms or us make it
+# 1e3 or 1e6 times too large, forces in kN 1e3 times too small.
+UNIT_FACTORS = ((1e3, "column 1 (time [s])", "are the times in milliseconds? They must be seconds"),
+                (1e6, "column 1 (time [s])", "are the times in microseconds? They must be seconds"),
+                (1e-3, "column 2 (force [N])", "are the forces in kN? They must be newtons"))
+END_FRACTION = 0.1      # a whole contact starts and ends near F = 0: an end above 10 % of the peak is cut off
 WHITENESS_SIGMAS = 3    # lag-1 autocorrelation of white residuals is about N(0, 1/n)
 STEPS_PER_CONTACT = 4000   # the model's internal step: the Hertz contact time / 4000 (F_peak to ~1e-7)
 ROWS_PER_CONTACT = 2000    # the model's force curve: a row every contact time / 2000, interpolated linearly
@@ -81,8 +88,9 @@ do not increase strictly; an isolated spike (a sample more than {SPIKE_FACTOR} t
 both its neighbours and {SPIKE_NOISE_LEVELS} noise levels, the noise estimated from the
 median step); forces whose largest magnitude is negative (wrong sign); an
 impulse (integral of F dt) outside {IMPULSE_RANGE[0]:.2g} to {IMPULSE_RANGE[1]:g} times m v, where a rebound
-gives 1 to 2 (times in milliseconds, forces in kN, or a wrong --m or
---height); fewer than {MIN_PEAK_SAMPLES} samples above half the peak force. Several
+gives 1 to 2 (a curve that does not hold the whole contact, times in
+milliseconds or microseconds, forces in kN, or a wrong --m or --height:
+the message says which fits); fewer than {MIN_PEAK_SAMPLES} samples above half the peak force. Several
 curves (--curve repeated, each with its --height or --v in the same order)
 share k and the damper; each has its own t0, and its residuals are weighed
 by their own noise level (from a first, unweighted pass).
@@ -299,13 +307,30 @@ def check_curve(path, t, F, lines, m, v):
                        f"{F[largest]:g} N at row {lines[largest]}; compression must be positive")
     ratio = float(np.trapezoid(F, t)) / (m * v)
     if not IMPULSE_RANGE[0] <= ratio <= IMPULSE_RANGE[1]:
-        column, hint = (("column 1 (time [s])", "are the times in milliseconds (or microseconds)? They must be seconds")
-                        if ratio > 1 else ("column 2 (force [N])", "are the forces in kN? They must be newtons"))
-        raise BadInput(f"{path}: {column}: the impulse (integral of F dt) is {ratio:.3g} times m v = "
-                       f"{m * v:.4g} N s where a rebound gives 1 to 2: {hint} (or --m, --height are wrong)")
+        where, hint = impulse_hint(F, lines, ratio)
+        raise BadInput(f"{path}: {where}: the impulse (integral of F dt) is {ratio:.3g} times m v = "
+                       f"{m * v:.4g} N s where a rebound gives 1 to 2: {hint}")
     if np.count_nonzero(F >= 0.5 * F.max()) < MIN_PEAK_SAMPLES:
         raise BadInput(f"{path}: column 1 (time [s]): fewer than {MIN_PEAK_SAMPLES} samples above half the "
                        f"peak force; the curve is sampled too coarsely to fit")
+
+
+def impulse_hint(F, lines, ratio):
+    """Where a wrong impulse comes from, and what to check: a curve that
+    does not hold the whole contact (its first or last force above
+    END_FRACTION of the peak), else a unit whose factor explains the ratio,
+    else the striker's mass and speed."""
+    peak = float(F.max())
+    for i, end in ((0, "starts"), (-1, "ends")):
+        if F[i] > END_FRACTION * peak:
+            return (f"row {lines[i]}, column 2 (force [N])",
+                    f"the curve {end} at {F[i]:.4g} N, {F[i] / peak:.0%} of its peak: it must hold the whole "
+                    "contact, from before its onset to after the separation")
+    for factor, column, hint in UNIT_FACTORS:
+        if IMPULSE_RANGE[0] <= ratio / factor <= IMPULSE_RANGE[1]:
+            return column, hint
+    return ("columns 1 and 2", "no unit (ms or us for the times, kN for the forces) explains it: are --m and "
+            "--height (or --v) this test's, and the columns the time [s] and the force [N]?")
 
 
 def half_peak_time(t, F):
@@ -1138,25 +1163,6 @@ def family_report(result):
 # The command line.
 
 
-def finite(text):
-    """argparse type: a finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a number")
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text} is not a finite number")
-    return value
-
-
-def positive(text):
-    """argparse type: a finite number > 0."""
-    value = finite(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text} is not positive")
-    return value
-
-
 def order(text):
     """argparse type: a springpot order, 0 < alpha <= 1."""
     value = finite(text)
@@ -1187,13 +1193,6 @@ def plot_file(text):
         raise argparse.ArgumentTypeError(f"{text}: unknown image type '{path.suffix}'; use one of "
                                          f"{', '.join(sorted(formats))}")
     return path
-
-
-class OneLineParser(argparse.ArgumentParser):
-    """Errors as one line on stderr, exit status 2."""
-
-    def error(self, message):
-        self.exit(2, f"fit: {message} (see --help)\n")
 
 
 def default_help(name, what):
@@ -1352,13 +1351,13 @@ def main(argv=None, prog=None):
                     warnings.append(f"chi-square {result['chi2']:.3g} for {result['dof']} degrees of freedom is above "
                                     "its 99.9 % quantile: the model misses the data or the sigmas are too small")
     except BadInput as e:
-        print(f"fit: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 2
     except Unreachable as e:
-        print(f"fit: not reachable by this model: {e}", file=sys.stderr)
+        print(f"{parser.prog}: not reachable by this model: {e}", file=sys.stderr)
         return 2
     except RuntimeError as e:
-        print(f"fit: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 1
     result.setdefault("m", args.m)
     result.setdefault("law", args.law)
@@ -1371,7 +1370,7 @@ def main(argv=None, prog=None):
         for mb in result["family"]["members"]:
             mb.pop("x", None)
     for w in warnings:
-        print(f"fit: warning: {w}", file=sys.stderr)
+        print(f"{parser.prog}: warning: {w}", file=sys.stderr)
     if args.json:
         print(json.dumps(result))
     else:

@@ -2,7 +2,9 @@
 the co-simulation driver, the hostile-input report and the tests use it."""
 
 import atexit
+import collections
 import functools
+import pathlib
 import shutil
 from ctypes import byref
 
@@ -15,6 +17,31 @@ from fmpy.logging import addLoggerProxy
 # which a later FMU that logs (a warning from fmpy.simulate_fmu, say) calls:
 # so no callback handed to it may be freed before the process ends.
 _PROXIED_CALLBACKS = []
+# The proxy calls the last callback given, so an instance's messages may land
+# in another's log: every message also lands here, with its instance's name.
+_RECENT = collections.deque(maxlen=100)
+
+
+def description(path, names, fmi2=False):
+    """The model description of the co-simulation FMU file at path, which
+    must have the variables names (and be FMI 2.0 where fmi2, for the
+    masters driving FMU2Slave); else ValueError saying what the file is."""
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise ValueError("no such file" if not path.exists() else "not a file")
+    try:
+        md = read_model_description(str(path))
+    except Exception as e:  # fmpy's: BadZipFile, KeyError, XML and schema errors, each saying "not an FMU"
+        raise ValueError(f"not an FMU ({e})") from None
+    if md.coSimulation is None:
+        raise ValueError(f"the FMU {md.modelName} is not for co-simulation")
+    if fmi2 and md.fmiVersion != "2.0":
+        raise ValueError(f"the FMU {md.modelName} is FMI {md.fmiVersion}; this master drives FMI 2.0")
+    missing = [n for n in names if n not in {v.name for v in md.modelVariables}]
+    if missing:
+        shown = ", ".join(missing[:4]) + (f" and {len(missing) - 4} more" if len(missing) > 4 else "")
+        raise ValueError(f"the FMU {md.modelName} lacks the variables {shown}")
+    return md
 
 
 @functools.lru_cache(maxsize=None)
@@ -58,6 +85,7 @@ class Slave:
     def _logger(self, env, name, status, category, message):
         self.log.append((status, category.decode(), message.decode()))
         self.log_names.append(name.decode())
+        _RECENT.append((name.decode(), status, message.decode()))
 
     def start(self):
         self.fmu.enterInitializationMode()
@@ -92,6 +120,11 @@ class Slave:
     def last_error(self):
         errors = [m for s, c, m in self.log if s >= 3]
         return errors[-1] if errors else ""
+
+    def recent_error(self):
+        """The last error logged under this instance's name, in whichever
+        Slave's callback fmpy's proxy delivered it."""
+        return next((m for n, s, m in reversed(_RECENT) if n == self.fmu.instanceName and s >= 3), "")
 
     def free(self):
         self.fmu.terminate()

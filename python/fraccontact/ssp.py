@@ -18,10 +18,10 @@ T_END = 3e-3  # the SSD's DefaultExperiment: the impact and the rebound
 
 def ssp_path():
     """The scene: $DROP_TEST_SSP, else drop_test.ssp next to the contact FMU
-    (the build folder; the Python package does not ship it)."""
+    (the build folder, or the installed package, which ships both)."""
     path = pathlib.Path(os.environ.get("DROP_TEST_SSP") or fmu_path().parent / "drop_test.ssp")
     if not path.exists():
-        raise FileNotFoundError(f"{path} does not exist: build it (scripts/build makes build/drop_test.ssp)")
+        raise FileNotFoundError(f"{path} does not exist: build it (scripts/build makes build/drop_test.ssp; pip install . puts it in the package)")
     return path
 
 

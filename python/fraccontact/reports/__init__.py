@@ -2,9 +2,11 @@
 fraccontact report NAME (scripts/report NAME from the source tree)."""
 
 import argparse
+import os
 import pathlib
 
 from .. import fmu_path, solver
+from ..options import OneLineParser
 
 
 def source_tree():
@@ -19,7 +21,7 @@ def source_tree():
 
 def parser(prog, doc, out_help="folder of the report (default: docs/)"):
     """A report's command line: its docstring as help, and --out."""
-    p = argparse.ArgumentParser(prog=prog, description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = OneLineParser(prog=prog, description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("docs"), help=out_help)
     return p
 
@@ -34,9 +36,22 @@ def add_fmu(p):
     p.add_argument("--fmu", type=pathlib.Path, help="the FMU (default: fraccontact.fmu_path(), $FRACCONTACT_FMU)")
 
 
-def parse(p, argv):
+def make_folder(p, out):
+    """The report's folder (--out), made before anything is computed: a report
+    of minutes must not fail at its end for want of it. One that cannot be
+    made or written is a usage error."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        p.error(f"--out {out}: cannot make the folder ({e.strerror})")
+    if not os.access(out, os.W_OK):
+        p.error(f"--out {out}: the folder is not writable")
+
+
+def parse(p, argv, check=None):
     """The arguments, --solver and --fmu (where the report has them) filled
-    in with their defaults; one that cannot be found is a usage error."""
+    in with their defaults, check(p, args) (the report's own rules) passed,
+    then --out made; one that cannot be found or made is a usage error."""
     args = p.parse_args(argv)
     try:
         if "solver" in args:
@@ -47,4 +62,7 @@ def parse(p, argv):
                 raise FileNotFoundError(f"{args.fmu} does not exist: build it first (scripts/build)")
     except (solver.Failed, FileNotFoundError) as e:
         p.error(str(e))
+    if check is not None:
+        check(p, args)
+    make_folder(p, args.out)
     return args

@@ -1107,7 +1107,6 @@ def main(argv=None, prog=None):
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = reports.parse(parser, argv)
     program, bench = args.solver, solver.bench_path(args.solver)
-    args.out.mkdir(parents=True, exist_ok=True)
     if args.only == "precision":
         say("work against precision ...")
         section = precision(reports.source_tree(), program, bench, args.fmu, args.out)

@@ -145,7 +145,6 @@ def main(argv=None, prog=None):
     scene = ssp_runs(ssp, contact, striker)
     g1 = monolithic(contact, law=1)
     progress(total, total, "done")
-    args.out.mkdir(parents=True, exist_ok=True)
     plot(args.out / "cosimulation.png", results, forced, traces)
     write(args.out / "cosimulation.md", results, forced, ref, ref_g, scene, g1, spring)
     print((args.out / "cosimulation.md").read_text())

@@ -156,7 +156,6 @@ def main(argv=None, prog=None):
         done += 1
     progress(total, total, "done")
 
-    args.out.mkdir(parents=True, exist_ok=True)
     plot(args.out / "error_vs_runtime.png", results, adaptive_rows, scipy_rows, gsl_rows)
     write_report(args.out / "error_vs_runtime.md", results, adaptive_rows, scipy_rows, gsl_rows, ref)
     print(f"wrote {args.out / 'error_vs_runtime.md'} and {args.out / 'error_vs_runtime.png'}")

@@ -1013,5 +1013,4 @@ def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     reports.add_fmu(parser)
     args = reports.parse(parser, argv)
-    args.out.mkdir(parents=True, exist_ok=True)
     write_report(args)

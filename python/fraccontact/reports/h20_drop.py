@@ -6,17 +6,23 @@ Regenerate: scripts/run   (fraccontact run --help)
 """
 
 import csv
+import sys
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from fmpy import simulate_fmu  # noqa: E402
+from fmpy.fmi1 import FMICallException  # noqa: E402
 
-from .. import atomic, model, reports  # noqa: E402
+from .. import atomic, fmu, model, reports  # noqa: E402
+from ..options import positive  # noqa: E402
 
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
 OUTPUTS = ["F", "x", "x1", "x2", "v_striker", "eps", "F_peak", "E_diss", "contact"]
+# fmpy holds every row as a tuple of Python floats until the end of a run, and the CSV writes them all:
+# the rows a run may make (stop time / output interval), within a desktop's memory and a few minutes.
+MAX_ROWS = 1_000_000
 
 
 def simulate(fmu, law, stop_time, output_interval):
@@ -24,11 +30,13 @@ def simulate(fmu, law, stop_time, output_interval):
                         output_interval=output_interval, output=OUTPUTS)
 
 
+def ended(result):
+    """Whether the first impact has ended (the FMU's eps is 0 before one ends)."""
+    return bool((result["eps"] > 0.0).any())
+
+
 def summary(result):
     """Figures of the first impact, from the outputs once it has ended."""
-    ended = result["eps"] > 0.0
-    if not ended.any():
-        raise SystemExit("the impact did not end within the simulated time: raise --stop-time")
     last = result[-1]
     # After separation the striker flies freely (no gravity here), so the
     # separation time follows from the gap it has opened since.
@@ -86,16 +94,36 @@ def plot(path, results, figures):
     atomic.save_figure(fig, path, dpi=110, metadata={"Software": None})
 
 
+def check(parser, args):
+    """The options together, before the run: the FMU is the contact element,
+    and the rows (stop time / output interval) are at most MAX_ROWS."""
+    try:
+        fmu.description(args.fmu, ["law"] + OUTPUTS)
+    except ValueError as e:
+        parser.error(f"--fmu {args.fmu}: {e}; expected the contact FMU (fraccontact.fmu)")
+    if args.output_interval > args.stop_time:
+        parser.error(f"--output-interval {args.output_interval:g} s is longer than --stop-time {args.stop_time:g} s")
+    rows = args.stop_time / args.output_interval
+    if rows > MAX_ROWS:
+        parser.error(f"--output-interval {args.output_interval:g} s over --stop-time {args.stop_time:g} s gives "
+                     f"{rows:.3g} rows; at most {MAX_ROWS:.0e} (stop time / output interval)")
+
+
 def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__, "folder for h20_drop.csv and h20_drop.png (default: docs/)")
     reports.add_fmu(parser)
-    parser.add_argument("--stop-time", type=float, default=3e-3, help="simulated time [s] (default 3e-3)")
-    parser.add_argument("--output-interval", type=float, default=2e-6,
-                        help="output sampling [s] (default 2e-6)")
-    args = reports.parse(parser, argv)
-    args.out.mkdir(parents=True, exist_ok=True)
+    parser.add_argument("--stop-time", type=positive, default=3e-3, help="simulated time [s] (default 3e-3)")
+    parser.add_argument("--output-interval", type=positive, default=2e-6,
+                        help=f"output sampling [s] (default 2e-6; at most {MAX_ROWS:.0e} rows: stop time / interval)")
+    args = reports.parse(parser, argv, check)
 
-    results = {law: simulate(args.fmu, law, args.stop_time, args.output_interval) for law in LAWS}
+    try:
+        results = {law: simulate(args.fmu, law, args.stop_time, args.output_interval) for law in LAWS}
+    except FMICallException as e:  # fmpy has printed the FMU's message, which names the value and the rule
+        print(f"{parser.prog}: the FMU refused the run ({e}): see its message above", file=sys.stderr)
+        return 2
+    if not all(ended(r) for r in results.values()):
+        parser.error(f"--stop-time {args.stop_time:g} s: the impact has not ended by then; raise it")
     figures = {law: summary(r) for law, r in results.items()}
     print_table(figures)
     gap = figures[1]["F_peak"] / PAPER["F_peak"] - 1

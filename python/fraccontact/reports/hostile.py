@@ -717,7 +717,6 @@ def main(argv=None, prog=None):
         expect = verdict_of(c) + (f" ({c['expect']})" if verdict_of(c) == RUNS else "")
         cells = [name, expect, c["why"], r["observed"], str(detail)]
         out.append("| " + " | ".join(s.replace("|", "/") for s in cells) + " |")
-    args.out.mkdir(parents=True, exist_ok=True)
     atomic.write_text((args.out / "reliability_hostile.md"), "\n".join(out) + "\n")
     print(f"{len(rows) - len(bad)} passed, {len(bad)} failed")
     for name, c, r, j in bad:

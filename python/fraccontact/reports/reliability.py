@@ -17,7 +17,7 @@ import sys
 
 from .. import atomic
 from ..progress import progress
-from . import source_tree
+from . import make_folder, source_tree
 
 ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
@@ -163,6 +163,7 @@ def main(argv=None, prog=None):
     parser.add_argument("--fuzz-seconds", type=int, default=300)
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
     args = parser.parse_args(argv)
+    make_folder(parser, args.out)
     progress(0, 4, "soak")
     s = soak(args.build)
     progress(1, 4, "valgrind")
