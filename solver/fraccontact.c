@@ -1,6 +1,7 @@
 #include "fraccontact.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -199,16 +200,19 @@ static void keep(series *s, const contact_model *cm)
 
 /* Rows at the output times k * interval in (before->s.t, t], each the model
  * advanced from `before` to that time: what the rows show never changes the
- * steps the run takes. */
-static void keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
+ * steps the run takes. Returns the internal steps they took. */
+static int64_t keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
 {
+    int64_t steps = 0;
     for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
         contact_model at = *before;
         double tau = (double)*k * interval - before->s.t;
         if (tau > 0.0 && isnan(contact_advance(&at, tau)))
-            return;
+            break;
+        steps += 1 + at.s.steps - before->s.steps;
         keep(out, &at);
     }
+    return steps;
 }
 
 /* The full G1 history lives on its grid and cannot be copied cheaply: its
@@ -224,6 +228,39 @@ static void keep_grid_rows_until(series *out, const contact_model *cm, double in
         return;
     keep(out, cm);
     *k = (int64_t)floor(cm->s.t / interval) + 1;
+}
+
+/* The progress callback comes after about this much work, in units of one
+ * internal step of the compressed memory (the dearest step but the full G1
+ * history's): well within a tenth of a second of CPU. */
+#define PROGRESS_WORK 8192
+
+/* A step of the full G1 history sums over every step before it: it costs
+ * about one unit more per this many of them. */
+#define HISTORY_PER_UNIT 64
+
+typedef struct {
+    fc_progress report; /* NULL: none */
+    void *ctx;
+    int64_t work, next; /* work done so far, and where the next call falls */
+} watch;
+
+/* The work of the steps from `before` to `after` steps of the run. */
+static int64_t work_of(const contact_params *q, int64_t before, int64_t after)
+{
+    if (q->damper == CONTACT_DAMPER_SPRINGPOT && q->memory == CONTACT_MEMORY_G1)
+        return (after - before) * (1 + after / HISTORY_PER_UNIT);
+    return after - before;
+}
+
+/* Counts the work and calls the callback when it is due: 1 when it asks to stop. */
+static int stop_asked(watch *w, int64_t work, const contact_model *cm)
+{
+    w->work += work;
+    if (!w->report || w->work < w->next)
+        return 0;
+    w->next = w->work + PROGRESS_WORK;
+    return w->report(w->ctx, cm->s.t, cm->s.steps, cm->s.impacts) != 0;
 }
 
 /* Why the run stops here, if it does; `slack`: how far short of t_end the
@@ -281,13 +318,13 @@ static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 
 /* The run behind fc_run and fc_run_batch: out may be NULL (no rows), and
  * impacts NULL (only the first is kept, in r->outcome.first). */
-static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts,
-                     fc_progress progress, void *ctx, fc_outcome *o, char *msg, size_t len)
+static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts, watch *w,
+                     fc_outcome *o, char *msg, size_t len)
 {
     contact_params q;
     contact_model cm, snapshot;
     double E_diss_onset = 0.0;
-    int64_t k = 1, reported = 0;
+    int64_t k = 1, row_steps = 0;
     int uniform, grid;
     memset(o, 0, sizeof *o);
     if (fc_params_check(p, msg, len) != FC_OK)
@@ -330,14 +367,15 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             if (grid)
                 keep_grid_rows_until(out, &cm, interval, &k);
             else if (rows_inside)
-                keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
+                row_steps = keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
             if (interval == 0.0 || cm.s.in_contact != before.in_contact)
                 keep(out, &cm);
         }
-        if (progress && cm.s.steps - reported >= 65536) {
-            reported = cm.s.steps;
-            progress(ctx, cm.s.t, cm.s.steps, cm.s.impacts);
+        if (stop_asked(w, work_of(&q, before.steps, cm.s.steps) + row_steps, &cm)) {
+            snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", cm.s.t);
+            return finish(&cm, o, FC_ESTOPPED);
         }
+        row_steps = 0;
     }
     if (out) {
         keep(out, &cm);
@@ -354,10 +392,11 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
 {
     series rows = {NULL, 0, 0, 0};
     impact_list impacts = {NULL, 0, 0};
+    watch w = {progress, ctx, 0, PROGRESS_WORK};
     fc_status status;
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
-    status = run(p, interval, interval >= 0.0 ? &rows : NULL, &impacts, progress, ctx, &r->outcome, msg, len);
+    status = run(p, interval, interval >= 0.0 ? &rows : NULL, &impacts, &w, &r->outcome, msg, len);
     r->per_impact = impacts.list;
     r->n_impacts = impacts.n;
     r->rows = rows.rows;
@@ -377,15 +416,44 @@ void fc_result_free(fc_result *r)
     memset(r, 0, sizeof *r);
 }
 
-fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out)
+/* A batch's callback as a run's: the cases finished so far, of n. */
+typedef struct {
+    fc_batch_progress report;
+    void *ctx;
+    size_t done, n;
+} batch_watch;
+
+static int batch_progress(void *ctx, double t, int64_t steps, int64_t impacts)
+{
+    batch_watch *b = ctx;
+    (void)t, (void)steps, (void)impacts;
+    return b->report(b->ctx, b->done, b->n);
+}
+
+fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outcome *out, fc_batch_progress progress,
+                                     void *ctx)
 {
     char why[FC_MESSAGE_SIZE];
-    fc_status first = FC_OK;
+    batch_watch b = {progress, ctx, 0, n};
+    watch w = {progress ? batch_progress : NULL, &b, 0, PROGRESS_WORK};
+    fc_status first = FC_OK, status = FC_OK;
     size_t i;
-    for (i = 0; i < n; i++) {
-        fc_status status = run(&params[i], FC_NO_ROWS, NULL, NULL, NULL, NULL, &out[i], why, sizeof why);
+    for (i = 0; i < n && status != FC_ESTOPPED; i++) {
+        b.done = i;
+        status = run(&params[i], FC_NO_ROWS, NULL, NULL, &w, &out[i], why, sizeof why);
         if (first == FC_OK)
             first = status;
+        if (status != FC_ESTOPPED && progress && progress(ctx, i + 1, n) != 0 && i + 1 < n)
+            status = FC_ESTOPPED;
     }
-    return first;
+    for (; i < n; i++) { /* not run */
+        memset(&out[i], 0, sizeof out[i]);
+        out[i].status = FC_ESTOPPED;
+    }
+    return status == FC_ESTOPPED ? FC_ESTOPPED : first;
+}
+
+fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out)
+{
+    return fc_run_batch_with_progress(n, params, out, NULL, NULL);
 }

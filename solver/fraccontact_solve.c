@@ -518,14 +518,15 @@ typedef struct {
     int impacts;
 } progress_line;
 
-static void show_progress(void *ctx, double t, int64_t steps, int64_t impacts)
+static int show_progress(void *ctx, double t, int64_t steps, int64_t impacts)
 {
     progress_line *line = ctx;
     if (cpu_seconds() - line->shown < 0.5)
-        return;
+        return 0;
     line->shown = cpu_seconds();
     fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " steps, %" PRId64 " of %d impacts   ", t,
             line->t_end, steps, impacts, line->impacts);
+    return 0;
 }
 
 static int solve_model(const options *o, double interval, fc_result *r)
