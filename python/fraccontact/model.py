@@ -29,12 +29,19 @@ scipy's OptimizeResult.
                constant used.
   Series   what simulate() returns: the columns t, F, x, x1, x2, v, E_diss
            (arrays, SI units), and run, the Run impact() gives for the same
-           parameters."""
+           parameters.
+
+A library call stops at Ctrl-C (KeyboardInterrupt) and, on a terminal,
+shows how far it has come when it runs longer than a few seconds."""
 
 import collections.abc
 import ctypes
 import math
 import numbers
+import signal
+import sys
+import threading
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -50,6 +57,8 @@ NAMES = tuple(p["name"] for p in _lib.PARAMETERS)
 INTEGERS = frozenset(p["name"] for p in _lib.PARAMETERS if p["kind"] == "integer")
 UNITS = dict({p["name"]: p["unit"] for p in _lib.PARAMETERS}, height="m")
 C_INT = np.iinfo(np.intc)
+SHOW_AFTER = 3.0  # s: a library call longer than this shows its progress on a terminal
+REDRAW = 0.5      # s between two drawings of that line
 
 
 class ParameterWarning(UserWarning):
@@ -327,11 +336,61 @@ def _run(o, per_impact, shape=None):
                stopped=form(STOP_WORDS[o["stop"]]), impacts=form(o["impacts"]), steps=form(o["steps"]), k=form(o["k"]))
 
 
+class _Watch:
+    """A library call's progress callbacks, as a context around the call.
+    In the main thread, Ctrl-C asks the library to stop: Python runs its
+    SIGINT handler inside the next callback, which then returns nonzero, and
+    KeyboardInterrupt is raised once the library has returned. On a terminal
+    a line on stderr tells how far a call longer than SHOW_AFTER has come."""
+
+    def __enter__(self):
+        self.main = threading.current_thread() is threading.main_thread()
+        self.stop = False
+        self.drawn = False
+        self.due = time.monotonic() + SHOW_AFTER
+        self.handler = signal.getsignal(signal.SIGINT) if self.main else None
+        if self.handler is signal.default_int_handler:  # a handler the user set stays
+            signal.signal(signal.SIGINT, self._interrupted)
+        return self
+
+    def _interrupted(self, signum, frame):
+        self.stop = True
+
+    def __exit__(self, kind, error, trace):
+        if self.handler is signal.default_int_handler:
+            signal.signal(signal.SIGINT, self.handler)
+        if self.drawn:
+            print(file=sys.stderr, flush=True)
+        if self.stop and kind is None:
+            raise KeyboardInterrupt
+
+    def poll(self, text):
+        """What a callback returns: nonzero to stop. text() says how far the
+        call has come."""
+        try:
+            if self.main and time.monotonic() >= self.due and sys.stderr.isatty():
+                print(f"\rfraccontact: {text()} (Ctrl-C stops)", end="", file=sys.stderr, flush=True)
+                self.drawn, self.due = True, time.monotonic() + REDRAW
+        except KeyboardInterrupt:  # raised by a SIGINT handler of the user's
+            self.stop = True
+        return int(self.stop)
+
+    def run(self):
+        return _lib.PROGRESS(lambda ctx, t, steps, impacts: self.poll(
+            lambda: f"t = {t:.6g} s, {steps} internal steps, {impacts} impacts"))
+
+    def batch(self):
+        return _lib.BATCH_PROGRESS(lambda ctx, done, n: self.poll(lambda: f"{done} of {n} runs"))
+
+
 def _call_run(p, interval):
     r = _lib.Result()
     why = _lib.message_buffer()
     try:
-        status = _lib.LIB.fc_run(ctypes.byref(p), interval, ctypes.byref(r), why, len(why))
+        with _Watch() as watch:
+            progress = watch.run()
+            status = _lib.LIB.fc_run_with_progress(ctypes.byref(p), interval, progress, None, ctypes.byref(r), why,
+                                                   len(why))
         if status != _lib.FC_OK:
             raise (ValueError if status == _lib.FC_EINVAL else RuntimeError)(why.value.decode())
         per_impact = [Impact(*(getattr(r.per_impact[i], name) for name in IMPACT_FIGURES))
@@ -382,7 +441,10 @@ def impacts(**params):
         batch[name] = np.broadcast_to(x, shape).ravel()
     _warn_unused_in(batch, shape)
     out = np.zeros(len(batch), dtype=np.dtype(_lib.Outcome))
-    if _lib.LIB.fc_run_batch(len(batch), batch.ctypes.data, out.ctypes.data) != _lib.FC_OK:
+    with _Watch() as watch:
+        progress = watch.batch()
+        status = _lib.LIB.fc_run_batch_with_progress(len(batch), batch.ctypes.data, out.ctypes.data, progress, None)
+    if status != _lib.FC_OK:
         _raise_for_case(batch, out, shape)
     return _run(out, None, shape)
 
