@@ -33,7 +33,7 @@ typedef enum {
     FC_OK = 0,
     FC_EINVAL = 1, /* a parameter breaks its rule: the message names it, its value and the rule */
     FC_EFAIL = 2,  /* the state became non-finite (never for valid parameters; a guard) */
-    FC_ENOMEM = 3, /* out of memory for rows or impacts */
+    FC_ENOMEM = 3, /* out of memory for rows or impacts, or more rows than FC_ROWS_MAX */
     FC_ESTOPPED = 4 /* a progress callback asked the run to stop */
 } fc_status;
 
@@ -158,6 +158,21 @@ typedef struct {
 #define FC_NO_ROWS (-1.0)
 #define FC_EVERY_STEP 0.0
 #define FC_DEFAULT_ROWS (-2.0)
+
+/* What a run may take: internal steps, and rows of its time series (56 B
+ * each). fc_run refuses up front a run that would need more (FC_EINVAL, the
+ * message naming dt_max or output_interval), estimated from the least it
+ * must cover: to its first onset, then its impacts, each at least the
+ * elastic Hertz contact time at the first impact's speed (all of them when
+ * g brings the striker back), or until t_end if that comes first; and it
+ * stops a time series that outgrows its estimate at FC_ROWS_MAX rows
+ * (FC_ENOMEM). */
+#define FC_STEPS_MAX 1e9
+#define FC_ROWS_MAX 10000000
+
+/* FC_OK, or FC_EINVAL and the message of fc_params_check or of the limits
+ * above: what fc_run with this output_interval refuses before it starts. */
+FC_API fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, size_t len);
 
 /* 1/256 of the elastic Hertz contact time at the impact speed (about 250
  * rows per contact), or t_end / 1000 in the driven scene without mass. */
