@@ -5,9 +5,13 @@ one shape of result."""
 
 import dataclasses
 import os
+import pty
 import re
+import select
+import signal
 import subprocess
 import sys
+import time
 import warnings
 
 import numpy as np
@@ -203,3 +207,79 @@ def test_a_series_too_long_for_memory_is_refused_up_front():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=30)
     assert run.returncode == 0 and run.stdout.strip(), run.stderr
     assert "output_interval" in run.stdout and "1e-12" in run.stdout, run.stdout
+
+
+# --- item 4: Ctrl-C stops a long call; a terminal sees its progress ---------
+
+# The h20 impact in 6.6e8 internal steps: under the library's limit of 1e9,
+# so accepted, and about a minute and a half of work.
+LONG = "dt_max=2e-12"
+CALLS = [f"fraccontact.impact({LONG})", f"fraccontact.impacts({LONG}, c=np.array([5e3, 6e3]))",
+         f"fraccontact.simulate(output_interval=1e-4, {LONG})"]
+
+
+def started(call, stderr):
+    """A Python process well inside the library call: it said so, and had
+    time to pass the delay after which a terminal sees a progress line."""
+    code = f"import numpy as np\nimport fraccontact\nprint('calling', flush=True)\n{call}\n"
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=stderr, text=True)
+    assert p.stdout.readline() == "calling\n"
+    time.sleep(model.SHOW_AFTER + 1.0)
+    return p
+
+
+def interrupted(p):
+    """Seconds from Ctrl-C (SIGINT) until the process has ended."""
+    try:
+        p.send_signal(signal.SIGINT)
+        start = time.monotonic()
+        p.wait(timeout=10)
+        return time.monotonic() - start
+    finally:
+        p.kill()
+
+
+@pytest.mark.parametrize("call", CALLS)
+def test_ctrl_c_stops_a_long_call_within_a_second(call):
+    p = started(call, subprocess.PIPE)
+    assert interrupted(p) < 1.0
+    err = p.stderr.read()
+    assert p.returncode == -signal.SIGINT and err.rstrip().endswith("KeyboardInterrupt"), err
+    assert "fraccontact: " not in err  # no progress line but on a terminal
+
+
+def terminal_text(fd):
+    text = b""
+    while select.select([fd], [], [], 5)[0]:
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:  # the other end closed
+            break
+        if not chunk:
+            break
+        text += chunk
+    return text.decode()
+
+
+def test_a_long_call_shows_its_progress_on_a_terminal():
+    """On a terminal, after a few seconds: where the run is, and that Ctrl-C
+    stops it; the line ends before the traceback."""
+    ours, theirs = pty.openpty()
+    p = started(CALLS[0], theirs)
+    os.close(theirs)
+    assert interrupted(p) < 1.0
+    text = terminal_text(ours)
+    os.close(ours)
+    line = re.search(r"\rfraccontact: t = [0-9.e-]+ s, (\d+) internal steps, 0 impacts \(Ctrl-C stops\)\r?\n", text)
+    assert line and int(line.group(1)) > 0, text
+    assert text[line.end():].startswith("Traceback") and text.rstrip().endswith("KeyboardInterrupt"), text
+
+
+def test_a_short_call_draws_nothing_on_a_terminal():
+    ours, theirs = pty.openpty()
+    p = subprocess.Popen([sys.executable, "-c", "import fraccontact; fraccontact.impacts(c=[5e3, 6e3])"],
+                         stderr=theirs)
+    os.close(theirs)
+    assert p.wait(timeout=60) == 0
+    assert terminal_text(ours) == ""
+    os.close(ours)

@@ -473,6 +473,6 @@ def _raise_for_case(batch, out, shape):
     i = int(np.flatnonzero(out["status"] != _lib.FC_OK)[0])
     case = _case(_index(i, shape), shape)
     why = _lib.message_buffer()
-    if _lib.LIB.fc_params_check(_case_params(batch, i), why, len(why)) != _lib.FC_OK:
+    if _lib.LIB.fc_run_check(_case_params(batch, i), _lib.NO_ROWS, why, len(why)) != _lib.FC_OK:
         raise ValueError(f"{case}{why.value.decode()}")
     raise RuntimeError(f"{case}the run failed (status {out['status'][i]})")
