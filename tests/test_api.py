@@ -195,6 +195,37 @@ def test_the_shape_is_documented_in_one_place():
         assert cls in model.__doc__ and hasattr(fraccontact, cls)
 
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def readme_python_section():
+    text = open(os.path.join(ROOT, "README.md")).read()
+    return text.split("## In Python: the `fraccontact` package", 1)[1].split("\n## ", 1)[0]
+
+
+def test_the_readmes_python_section_runs_and_tells_the_shape():
+    """Its example runs as written, each result as its comments and the
+    text after it say; the words and limits it states are the package's."""
+    section = readme_python_section()
+    example = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    names = {}
+    exec(example, names)
+    r, a, s = names["r"], names["a"], names["s"]
+    assert isinstance(r, fraccontact.Run) and isinstance(a, fraccontact.Run) and isinstance(s, fraccontact.Series)
+    assert a.F_peak.shape == (1000,) and s.run.F_peak == fraccontact.impact().F_peak
+    prose = " ".join(section.split())
+    for name in RUN_FIELDS + END_FIELDS + SERIES_FIELDS:
+        assert f"`{name}`" in prose, name
+    for name, words in model.WORDS.items():
+        assert f"`{name}` {', '.join(words)}" in prose, name
+    steps, rows = (float(x) for x in re.search(r"more than (\S+) internal steps .* or (\S+) rows", prose).groups())
+    for run, limit in ((lambda: fraccontact.impact(dt_max=1e-13), steps),
+                       (lambda: fraccontact.simulate(output_interval=1e-12), rows)):
+        with pytest.raises(ValueError) as refused:
+            run()
+        assert float(re.search(r"more than (?:the )?(\S+)", str(refused.value)).group(1).rstrip(";,")) == limit
+
+
 # --- item 1: rows beyond what the machine holds, refused up front -----------
 
 def test_a_series_too_long_for_memory_is_refused_up_front():
