@@ -106,9 +106,13 @@ def _element(name, x):
         return WORDS.get(name, {}).get(x)
     if isinstance(x, bool) or not isinstance(x, numbers.Real):
         return None
+    try:
+        number = float(x)
+    except OverflowError:  # an integer beyond a double's range
+        return None
     if name not in INTEGERS:
-        return float(x)
-    return int(x) if math.isfinite(x) and x == math.floor(x) and C_INT.min <= x <= C_INT.max else None
+        return number
+    return int(x) if math.isfinite(number) and x == math.floor(x) and C_INT.min <= x <= C_INT.max else None
 
 
 def _converted(name, a):
@@ -262,7 +266,7 @@ class _Record(collections.abc.Mapping):
         return len(self.__dataclass_fields__)
 
 
-@dataclass(eq=True)
+@dataclass
 class Impact(_Record):
     """One finished impact."""
     t_onset: float    # contact onset [s]
@@ -274,7 +278,7 @@ class Impact(_Record):
     E_diss: float     # energy dissipated during it [J]
 
 
-@dataclass(eq=True)
+@dataclass
 class End(_Record):
     """The FMU's outputs where a run stopped."""
     t: float          # time [s]
@@ -291,7 +295,7 @@ class End(_Record):
 END_FIGURES = tuple(End.__dataclass_fields__)
 
 
-@dataclass(eq=True)
+@dataclass
 class Run(_Record):
     """A run, as fraccontact-solve --json gives it (numbers from impact(),
     arrays of the batch's shape from impacts())."""
@@ -310,7 +314,7 @@ class Run(_Record):
     k: float          # the spring constant used (given, or derived) [N/m^n]
 
 
-@dataclass(eq=True)
+@dataclass
 class Series(_Record):
     """A run's time series (arrays, SI units) and the run."""
     t: np.ndarray       # time [s]
