@@ -218,7 +218,7 @@ def test_the_readmes_python_section_runs_and_tells_the_shape():
         assert f"`{name}`" in prose, name
     for name, words in model.WORDS.items():
         assert f"`{name}` {', '.join(words)}" in prose, name
-    steps, rows = (float(x) for x in re.search(r"more than (\S+) internal steps .* or (\S+) rows", prose).groups())
+    steps, rows = (float(x) for x in re.search(r"more than (\S+) internal steps .*? more than (\S+) rows", prose).groups())
     for run, limit in ((lambda: fraccontact.impact(dt_max=1e-13), steps),
                        (lambda: fraccontact.simulate(output_interval=1e-12), rows)):
         with pytest.raises(ValueError) as refused:
