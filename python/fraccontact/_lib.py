@@ -101,7 +101,8 @@ for _struct, _size in ((Params, LIB.fc_params_size()), (Outcome, LIB.fc_outcome_
 
 LIB.fc_params_default.argtypes = [ctypes.POINTER(Params)]
 LIB.fc_params_check.argtypes = [ctypes.POINTER(Params), ctypes.c_char_p, ctypes.c_size_t]
-LIB.fc_params_warning.argtypes = [ctypes.POINTER(Params), ctypes.c_char_p, ctypes.c_size_t]
+# by address: a batch's cases are looked at in place
+LIB.fc_params_warning.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t]
 LIB.fc_run_check.argtypes = [ctypes.POINTER(Params), ctypes.c_double, ctypes.c_char_p, ctypes.c_size_t]
 LIB.fc_default_output_interval.argtypes = [ctypes.POINTER(Params)]
 LIB.fc_run.argtypes = [ctypes.POINTER(Params), ctypes.c_double, ctypes.POINTER(Result), ctypes.c_char_p,

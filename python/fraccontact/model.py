@@ -216,22 +216,22 @@ def _params(**given):
     return _checked(p)
 
 
-def _unused(p):
-    """The library's message for a value without effect in p, or None."""
-    why = _lib.message_buffer()
+def _unused(p, why):
+    """The library's message for a value without effect in the fc_params p
+    (a byref or an address), or None; why holds it."""
     return why.value.decode() if _lib.LIB.fc_params_warning(p, why, len(why)) else None
 
 
 def _warn_unused(p):
     """Warns (at the caller's caller) when a value of p has no effect."""
-    message = _unused(ctypes.byref(p))
+    message = _unused(ctypes.byref(p), _lib.message_buffer())
     if message:
         warnings.warn(message, ParameterWarning, stacklevel=3)
 
 
 def warning(**params):
     """The library's warning for these parameters (a value without effect), or None."""
-    return _unused(ctypes.byref(_params(**params)))
+    return _unused(ctypes.byref(_params(**params)), _lib.message_buffer())
 
 
 def memory_kernel(**params):
@@ -465,7 +465,8 @@ def _case_params(batch, i):
 def _warn_unused_in(batch, shape):
     """One warning for the cases with a value without effect: the first one's
     message, and how many."""
-    found = [(i, message) for i in range(len(batch)) if (message := _unused(_case_params(batch, i)))]
+    why, start = _lib.message_buffer(), batch.ctypes.data
+    found = [(i, message) for i in range(len(batch)) if (message := _unused(start + i * batch.itemsize, why))]
     if found:
         i, message = found[0]
         more = f" ({len(found)} of {len(batch)} cases have a value without effect)" if len(found) > 1 else ""
