@@ -1,6 +1,7 @@
 #include "fraccontact.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -174,17 +175,118 @@ static double elastic_contact_time(double n)
     return 2.0 * e * tgamma(e) * tgamma(0.5) / tgamma(e + 0.5);
 }
 
-double fc_default_output_interval(const fc_params *p)
+/* The elastic Hertz contact time at the impact speed [s], 0 when the
+ * striker never meets the specimen. */
+static double contact_time(const fc_params *p)
 {
     contact_params q;
     contact_model cm;
     double x_ref, t_ref, x_small;
-    if (p->scene == CONTACT_SCENE_DRIVEN && !(p->m > 0.0)) /* one contact, as long as the run */
-        return p->t_end / 1000.0;
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
     contact_scales(&q, contact_spring_stiffness(&cm, 0), p->v, p->m, &x_ref, &t_ref, &x_small);
-    return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref / 256.0 : p->t_end / 1000.0;
+    return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref : 0.0;
+}
+
+/* Whether the run is one contact as long as the run: the driven scene without mass. */
+static int driven_rate(const fc_params *p)
+{
+    return p->scene == CONTACT_SCENE_DRIVEN && !(p->m > 0.0);
+}
+
+double fc_default_output_interval(const fc_params *p)
+{
+    double t_c;
+    if (driven_rate(p)) /* one contact, as long as the run */
+        return p->t_end / 1000.0;
+    t_c = contact_time(p);
+    return t_c > 0.0 ? t_c / 256.0 : p->t_end / 1000.0;
+}
+
+/* ------------------------------------------------------------ a run's size */
+
+/* When the striker first meets the specimen (it falls through gap0 from v
+ * under g: gap0 = v t + g t^2 / 2), or infinity when it never does. */
+static double onset_time(const fc_params *p)
+{
+    double g = driven_rate(p) ? 0.0 : p->g, root = p->v * p->v + 2.0 * g * p->gap0, speed;
+    if (p->gap0 == 0.0 && (p->v > 0.0 || (p->v == 0.0 && g > 0.0)))
+        return 0.0;
+    speed = root >= 0.0 ? p->v + sqrt(root) : 0.0;
+    return speed > 0.0 ? 2.0 * p->gap0 / speed : INFINITY;
+}
+
+/* The least a run must cover before it may stop, short of t_end [s]: to its
+ * first onset, then its contacts, each at least the elastic contact time at
+ * the first impact's speed (later ones are slower, and longer), all
+ * `impacts` of them when an acceleration brings the striker back; the
+ * driven scene without mass is in contact until t_end. Of that, *in_contact
+ * is the contacts' part. */
+static double least_span(const fc_params *p, double *in_contact)
+{
+    double onset = onset_time(p), end = p->t_end, contacts;
+    *in_contact = 0.0;
+    if (!(onset < end))
+        return end;
+    contacts = driven_rate(p) ? end : contact_time(p) * (p->g > 0.0 ? (double)p->impacts : 1.0);
+    *in_contact = fmin(contacts, end - onset);
+    return onset + *in_contact;
+}
+
+/* The least number of internal steps of the run: steps of at most dt_max
+ * over its contacts, or over the whole span on a uniform grid. */
+static double least_steps(const fc_params *p)
+{
+    contact_params q;
+    contact_model cm;
+    double in_contact, span = least_span(p, &in_contact);
+    fc_model_params(p, &q);
+    contact_start(&cm, &q, p->v, p->m);
+    return (contact_steps_uniformly(&cm) ? span : in_contact) / p->dt_max;
+}
+
+static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
+{
+    char rule[256];
+    snprintf(rule, sizeof rule,
+             "the run would take at least %.3g internal steps of at most dt_max, more than %.0e; raise dt_max, or "
+             "lower t_end or impacts",
+             steps, FC_STEPS_MAX);
+    contact_reject(msg, len, "dt_max", p->dt_max, rule);
+    return FC_EINVAL;
+}
+
+fc_status run_rows_check(const fc_params *p, double interval, double steps, char *msg, size_t len)
+{
+    char rule[256];
+    double in_contact, span = least_span(p, &in_contact), rows = interval > 0.0 ? span / interval : steps;
+    if (interval == FC_NO_ROWS || interval == FC_DEFAULT_ROWS)
+        return FC_OK;
+    if (!(interval >= 0.0) || isinf(interval)) {
+        contact_reject(msg, len, "output_interval", interval,
+                       "the time between rows must be finite and >= 0 [s] (0: a row every internal step)");
+        return FC_EINVAL;
+    }
+    if (!(rows > FC_ROWS_MAX))
+        return FC_OK;
+    snprintf(rule, sizeof rule,
+             "the time series would hold at least %.3g rows (%s over %.3g s), more than the %.0e a run keeps; "
+             "raise output_interval, or lower t_end or impacts",
+             rows, interval > 0.0 ? "one every output_interval" : "one every internal step", span, (double)FC_ROWS_MAX);
+    contact_reject(msg, len, "output_interval", interval, rule);
+    return FC_EINVAL;
+}
+
+fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, size_t len)
+{
+    double steps, interval;
+    if (fc_params_check(p, msg, len) != FC_OK)
+        return FC_EINVAL;
+    steps = least_steps(p);
+    if (steps > FC_STEPS_MAX)
+        return reject_steps(p, steps, msg, len);
+    interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
+    return run_rows_check(p, interval, steps, msg, len);
 }
 
 /* ------------------------------------------------------------ a run */
@@ -197,18 +299,33 @@ static void keep(series *s, const contact_model *cm)
     series_add(s, row);
 }
 
-/* Rows at the output times k * interval in (before->s.t, t], each the model
- * advanced from `before` to that time: what the rows show never changes the
- * steps the run takes. */
-static void keep_rows_until(series *out, const contact_model *before, double t, double interval, int64_t *k)
+/* Rows at the output times k * interval in (from->s.t, t], each the model
+ * advanced to that time from a copy of the state, so that what the rows
+ * show never changes the steps the run takes. The copy is the last state
+ * of the run's own steps before the row: out of contact a recovering
+ * springpot's flight is one advance of many steps, which the rows retrace
+ * once, step by step, not once a row. Returns the internal steps they took. */
+static int64_t keep_rows_until(series *out, const contact_model *from, double t, double interval, int64_t *k)
 {
+    contact_model cursor, at;
+    int64_t steps = 0;
+    contact_copy(&cursor, from);
     for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
-        contact_model at = *before;
-        double tau = (double)*k * interval - before->s.t;
-        if (tau > 0.0 && isnan(contact_advance(&at, tau)))
-            return;
+        const double t_row = (double)*k * interval;
+        for (;;) {
+            contact_copy(&at, &cursor);
+            if (!(t_row > at.s.t))
+                break;
+            if (isnan(contact_advance_until(&at, t_row - at.s.t, CONTACT_FLIGHT_STEP)))
+                return steps;
+            steps += 1 + at.s.steps - cursor.s.steps;
+            if (!(at.s.t < t_row))
+                break;
+            contact_copy(&cursor, &at); /* a whole step of the run's short of the row */
+        }
         keep(out, &at);
     }
+    return steps;
 }
 
 /* The full G1 history lives on its grid and cannot be copied cheaply: its
@@ -224,6 +341,39 @@ static void keep_grid_rows_until(series *out, const contact_model *cm, double in
         return;
     keep(out, cm);
     *k = (int64_t)floor(cm->s.t / interval) + 1;
+}
+
+/* The progress callback comes after about this much work, in units of one
+ * internal step of the compressed memory (the dearest step but the full G1
+ * history's): well within a tenth of a second of CPU. */
+#define PROGRESS_WORK 8192
+
+/* A step of the full G1 history sums over every step before it: it costs
+ * about one unit more per this many of them. */
+#define HISTORY_PER_UNIT 64
+
+typedef struct {
+    fc_progress report; /* NULL: none */
+    void *ctx;
+    int64_t work, next; /* work done so far, and where the next call falls */
+} watch;
+
+/* The work of the steps from `before` to `after` steps of the run. */
+static int64_t work_of(const contact_params *q, int64_t before, int64_t after)
+{
+    if (q->damper == CONTACT_DAMPER_SPRINGPOT && q->memory == CONTACT_MEMORY_G1)
+        return (after - before) * (1 + after / HISTORY_PER_UNIT);
+    return after - before;
+}
+
+/* Counts the work and calls the callback when it is due: 1 when it asks to stop. */
+static int stop_asked(watch *w, int64_t work, const contact_model *cm)
+{
+    w->work += work;
+    if (!w->report || w->work < w->next)
+        return 0;
+    w->next = w->work + PROGRESS_WORK;
+    return w->report(w->ctx, cm->s.t, cm->s.steps, cm->s.impacts) != 0;
 }
 
 /* Why the run stops here, if it does; `slack`: how far short of t_end the
@@ -271,6 +421,20 @@ static fc_impact finished_impact(const contact_model *cm, double E_diss_onset)
     return done;
 }
 
+/* Why the time series stopped growing. */
+static fc_status rows_failed(const series *out, double interval, double t, char *msg, size_t len)
+{
+    char rule[256];
+    if (out->n < (size_t)FC_ROWS_MAX) {
+        contact_reject(msg, len, "rows", (double)out->n, "out of memory for the time series");
+        return FC_ENOMEM;
+    }
+    snprintf(rule, sizeof rule, "the time series reached the %.0e rows a run keeps at t = %.6g s; raise output_interval, "
+             "or lower t_end or impacts", (double)FC_ROWS_MAX, t);
+    contact_reject(msg, len, "output_interval", interval, rule);
+    return FC_ENOMEM;
+}
+
 /* Ends a run where cm is (with a message already written if it failed). */
 static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 {
@@ -281,16 +445,16 @@ static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 
 /* The run behind fc_run and fc_run_batch: out may be NULL (no rows), and
  * impacts NULL (only the first is kept, in r->outcome.first). */
-static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts,
-                     fc_progress progress, void *ctx, fc_outcome *o, char *msg, size_t len)
+static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts, watch *w,
+                     fc_outcome *o, char *msg, size_t len)
 {
     contact_params q;
     contact_model cm, snapshot;
     double E_diss_onset = 0.0;
-    int64_t k = 1, reported = 0;
+    int64_t k = 1, row_steps = 0;
     int uniform, grid;
     memset(o, 0, sizeof *o);
-    if (fc_params_check(p, msg, len) != FC_OK)
+    if (fc_run_check(p, out ? interval : FC_NO_ROWS, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
@@ -310,8 +474,8 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             H = fmin(H, q.dt_max);
         rows_inside = out && interval > 0.0 && !grid && (double)k * interval <= cm.s.t + H;
         if (rows_inside)
-            snapshot = cm; /* no G1 history in it: a plain copy */
-        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
+            contact_copy(&snapshot, &cm); /* no G1 history in it */
+        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION | CONTACT_PAUSE))) {
             contact_reject(msg, len, "t", cm.s.t, "the state became non-finite in the step from here [s]");
             return finish(&cm, o, FC_EFAIL);
         }
@@ -330,21 +494,22 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             if (grid)
                 keep_grid_rows_until(out, &cm, interval, &k);
             else if (rows_inside)
-                keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
+                row_steps = keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
             if (interval == 0.0 || cm.s.in_contact != before.in_contact)
                 keep(out, &cm);
+            if (out->failed)
+                break;
         }
-        if (progress && cm.s.steps - reported >= 65536) {
-            reported = cm.s.steps;
-            progress(ctx, cm.s.t, cm.s.steps, cm.s.impacts);
+        if (stop_asked(w, work_of(&q, before.steps, cm.s.steps) + row_steps, &cm)) {
+            snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", cm.s.t);
+            return finish(&cm, o, FC_ESTOPPED);
         }
+        row_steps = 0;
     }
     if (out) {
         keep(out, &cm);
-        if (out->failed) {
-            contact_reject(msg, len, "rows", (double)out->n, "out of memory for the time series");
-            return finish(&cm, o, FC_ENOMEM);
-        }
+        if (out->failed)
+            return finish(&cm, o, rows_failed(out, interval, cm.s.t, msg, len));
     }
     return finish(&cm, o, FC_OK);
 }
@@ -354,10 +519,11 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
 {
     series rows = {NULL, 0, 0, 0};
     impact_list impacts = {NULL, 0, 0};
+    watch w = {progress, ctx, 0, PROGRESS_WORK};
     fc_status status;
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
-    status = run(p, interval, interval >= 0.0 ? &rows : NULL, &impacts, progress, ctx, &r->outcome, msg, len);
+    status = run(p, interval, interval == FC_NO_ROWS ? NULL : &rows, &impacts, &w, &r->outcome, msg, len);
     r->per_impact = impacts.list;
     r->n_impacts = impacts.n;
     r->rows = rows.rows;
@@ -377,15 +543,44 @@ void fc_result_free(fc_result *r)
     memset(r, 0, sizeof *r);
 }
 
-fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out)
+/* A batch's callback as a run's: the cases finished so far, of n. */
+typedef struct {
+    fc_batch_progress report;
+    void *ctx;
+    size_t done, n;
+} batch_watch;
+
+static int batch_progress(void *ctx, double t, int64_t steps, int64_t impacts)
+{
+    batch_watch *b = ctx;
+    (void)t, (void)steps, (void)impacts;
+    return b->report(b->ctx, b->done, b->n);
+}
+
+fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outcome *out, fc_batch_progress progress,
+                                     void *ctx)
 {
     char why[FC_MESSAGE_SIZE];
-    fc_status first = FC_OK;
+    batch_watch b = {progress, ctx, 0, n};
+    watch w = {progress ? batch_progress : NULL, &b, 0, PROGRESS_WORK};
+    fc_status first = FC_OK, status = FC_OK;
     size_t i;
-    for (i = 0; i < n; i++) {
-        fc_status status = run(&params[i], FC_NO_ROWS, NULL, NULL, NULL, NULL, &out[i], why, sizeof why);
+    for (i = 0; i < n && status != FC_ESTOPPED; i++) {
+        b.done = i;
+        status = run(&params[i], FC_NO_ROWS, NULL, NULL, &w, &out[i], why, sizeof why);
         if (first == FC_OK)
             first = status;
+        if (status != FC_ESTOPPED && progress && progress(ctx, i + 1, n) != 0 && i + 1 < n)
+            status = FC_ESTOPPED;
     }
-    return first;
+    for (; i < n; i++) { /* not run */
+        memset(&out[i], 0, sizeof out[i]);
+        out[i].status = FC_ESTOPPED;
+    }
+    return status == FC_ESTOPPED ? FC_ESTOPPED : first;
+}
+
+fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out)
+{
+    return fc_run_batch_with_progress(n, params, out, NULL, NULL);
 }

@@ -33,7 +33,8 @@ typedef enum {
     FC_OK = 0,
     FC_EINVAL = 1, /* a parameter breaks its rule: the message names it, its value and the rule */
     FC_EFAIL = 2,  /* the state became non-finite (never for valid parameters; a guard) */
-    FC_ENOMEM = 3  /* out of memory for rows or impacts */
+    FC_ENOMEM = 3, /* out of memory for rows or impacts, or more rows than FC_ROWS_MAX */
+    FC_ESTOPPED = 4 /* a progress callback asked the run to stop */
 } fc_status;
 
 /* Why a run stopped. */
@@ -158,18 +159,38 @@ typedef struct {
 #define FC_EVERY_STEP 0.0
 #define FC_DEFAULT_ROWS (-2.0)
 
+/* What a run may take: internal steps, and rows of its time series (56 B
+ * each). fc_run refuses up front a run that would need more (FC_EINVAL, the
+ * message naming dt_max or output_interval), estimated from the least it
+ * must cover: to its first onset, then its impacts, each at least the
+ * elastic Hertz contact time at the first impact's speed (all of them when
+ * g brings the striker back), or until t_end if that comes first; and it
+ * stops a time series that outgrows its estimate at FC_ROWS_MAX rows
+ * (FC_ENOMEM). */
+#define FC_STEPS_MAX 1e9
+#define FC_ROWS_MAX 10000000
+
+/* FC_OK, or FC_EINVAL and the message of fc_params_check or of the limits
+ * above: what fc_run with this output_interval refuses before it starts. */
+FC_API fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, size_t len);
+
 /* 1/256 of the elastic Hertz contact time at the impact speed (about 250
  * rows per contact), or t_end / 1000 in the driven scene without mass. */
 FC_API double fc_default_output_interval(const fc_params *p);
 
-/* Called now and then during a long run (about every 65536 internal steps)
- * with the time reached, the steps taken and the impacts finished. */
-typedef void (*fc_progress)(void *ctx, double t, int64_t steps, int64_t impacts);
+/* Called now and then during a run with the time reached, the steps taken
+ * and the impacts finished; nonzero asks the run to stop there (FC_ESTOPPED).
+ * The calls are spaced by work, not steps (a step of the full G1 history
+ * costs in proportion to the steps before it): a fraction of a millisecond
+ * to a few tens of milliseconds of CPU apart, whatever the parameters. */
+typedef int (*fc_progress)(void *ctx, double t, int64_t steps, int64_t impacts);
 
 /* One run from t = 0 until `impacts` impacts have ended, t_end, or the
  * striker recedes for good: in contact one internal step at a time, free
  * flight in one exact step, as the FMU does. FC_OK, FC_EINVAL (nothing run),
- * FC_EFAIL or FC_ENOMEM, with a message; r is filled in every case (free it). */
+ * FC_EFAIL, FC_ENOMEM or FC_ESTOPPED (the progress callback asked to stop:
+ * r holds the run so far), with a message; r is filled in every case (free
+ * it). fc_run is fc_run_with_progress without a callback. */
 FC_API fc_status fc_run(const fc_params *p, double output_interval, fc_result *r, char *msg, size_t len);
 FC_API fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress,
                                       void *ctx, fc_result *r, char *msg, size_t len);
@@ -179,6 +200,17 @@ FC_API void fc_result_free(fc_result *r);
  * FC_OK when all ran; else the status of the first that did not (its
  * out[i].status says which; fc_params_check tells why). */
 FC_API fc_status fc_run_batch(size_t n, const fc_params *params, fc_outcome *out);
+
+/* Called after each case of a batch (done = the cases finished) and as
+ * often as fc_progress during a case (done unchanged); nonzero asks the
+ * batch to stop. */
+typedef int (*fc_batch_progress)(void *ctx, size_t done, size_t n);
+
+/* fc_run_batch with a progress callback: FC_ESTOPPED when it asked to stop
+ * (the case it stopped has out[i].status FC_ESTOPPED and its figures so
+ * far; the cases after it are not run: zeros, status FC_ESTOPPED). */
+FC_API fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outcome *out,
+                                            fc_batch_progress progress, void *ctx);
 
 /* The compressed memory's kernel for the parameters' damper_order,
  * memory_tolerance and dt_max (MODEL.md §8): tau^(-alpha)/Gamma(1-alpha) ~

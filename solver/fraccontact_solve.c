@@ -24,6 +24,7 @@
 typedef struct {
     fc_params p;
     double height, output_interval, rtol;
+    double interval; /* of the rows: FC_NO_ROWS without --csv */
     int repeat;
     const char *csv;
     int json, reference, quiet;
@@ -123,7 +124,7 @@ static void make_options(option_table *t)
                 snprintf(help + strlen(help), sizeof help - strlen(help), "%s%s", w ? ", " : "; or ", words[w]);
         add_option(t, name, kind, offsetof(options, p) + p->offset, p->name, NULL, help);
     }
-    add_option(t, "--output-interval", REAL, offsetof(options, output_interval), NULL, finite_nonnegative,
+    add_option(t, "--output-interval", REAL, offsetof(options, output_interval), "output_interval", finite_nonnegative,
                "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row "
                "after every internal step (large). Default: 1/256 of the elastic Hertz contact time at the impact "
                "speed (about 250 rows per contact; 4.8 us at the h20 defaults), or --t-end / 1000 in the driven "
@@ -171,7 +172,8 @@ static void usage(const option_table *t)
            "  method, k    sdirk2, esdirk5 (error-controlled steps, tolerance > 0), central, bdf2-g1 (a\n"
            "               springpot's full G1 history) or reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
-           "Exit status: 0 done, 2 bad options, 1 the solve or an output failed.\n");
+           "Exit status: 0 done, 2 bad options, 1 the solve or an output failed, 130 interrupted (Ctrl-C).\n"
+           "On a terminal a solve that takes more than a few seconds shows its progress on stderr.\n");
 }
 
 static void print_json_string(const char *text)
@@ -218,6 +220,21 @@ static int bad_option(const char *name, const char *value, const char *why)
     return 2;
 }
 
+/* "one of WORD, ... or 1, ..., n": what a word option takes. */
+static const char *word_rule(const char *const words[], char *rule, size_t len)
+{
+    int i, n;
+    size_t used;
+    for (n = 0; words[n]; n++)
+        ;
+    used = (size_t)snprintf(rule, len, "one of");
+    for (i = 0; i < n && used < len; i++)
+        used += (size_t)snprintf(rule + used, len - used, "%s %s", i ? "," : "", words[i]);
+    for (i = 1; i <= n && used < len; i++)
+        used += (size_t)snprintf(rule + used, len - used, "%s%d", i == 1 ? " or " : ", ", i);
+    return rule;
+}
+
 static int parse_word(const char *value, const char *const words[], int *out)
 {
     int i;
@@ -238,7 +255,7 @@ static int parse_word(const char *value, const char *const words[], int *out)
 /* Reads the value into its field; 0, or 2 after a message. */
 static int set_option(options *o, const option *opt, const char *value)
 {
-    char *at = (char *)o + opt->offset, *end;
+    char *at = (char *)o + opt->offset, *end, rule[128];
     const char *broken;
     switch (opt->kind) {
     case REAL:
@@ -256,11 +273,12 @@ static int set_option(options *o, const option *opt, const char *value)
         break;
     }
     case LAW:
-        return parse_word(value, law_words, (int *)at) ? bad_option(opt->name, value, "one of g1, hertz, g1x") : 0;
     case SCHEME:
-        return parse_word(value, scheme_words, (int *)at) ? bad_option(opt->name, value, "one of sdirk2, central") : 0;
-    case SCENE:
-        return parse_word(value, scene_words, (int *)at) ? bad_option(opt->name, value, "one of drop, driven") : 0;
+    case SCENE: {
+        const char *const *words = opt->kind == LAW ? law_words : opt->kind == SCHEME ? scheme_words : scene_words;
+        return parse_word(value, words, (int *)at) ? bad_option(opt->name, value, word_rule(words, rule, sizeof rule))
+                                                   : 0;
+    }
     case TEXT:
         *(const char **)at = value;
         break;
@@ -272,15 +290,11 @@ static int set_option(options *o, const option *opt, const char *value)
     return broken ? bad_option(opt->name, value, broken) : 0;
 }
 
-/* The library's own checks; its message names its variable, which names the
- * option and the value as typed. */
-static int check_model(const option_table *t, const options *o)
+/* A message of the library's checks: it names its variable, which names the
+ * option and the value as typed. Returns 2. */
+static int bad_model(const option_table *t, const options *o, const char *why)
 {
-    char why[FC_MESSAGE_SIZE];
-    size_t k, n;
-    if (fc_params_check(&o->p, why, sizeof why) == FC_OK)
-        return 0;
-    n = strcspn(why, " ");
+    size_t k, n = strcspn(why, " ");
     for (k = 0; k < t->n; k++)
         if (o->typed[k] && t->list[k].variable && strlen(t->list[k].variable) == n
             && strncmp(why, t->list[k].variable, n) == 0)
@@ -298,12 +312,55 @@ static const char *typed_value(const option_table *t, const options *o, const ch
     return NULL;
 }
 
+/* The options of one method only: --rtol of --reference; the model's
+ * steps, which --reference does not take, and what it cannot solve. */
+static int check_method(const option_table *t, options *o)
+{
+    static const char *const own_steps[] = {"--scheme", "--dt-max", "--tolerance"};
+    const char *value;
+    size_t i;
+    if (!o->reference) {
+        value = typed_value(t, o, "--rtol");
+        return value ? bad_option("--rtol", value, "the relative tolerance of --reference, which is not given") : 0;
+    }
+    if (o->p.damper != 1)
+        return bad_option("--damper", typed_value(t, o, "--damper"),
+                          "--reference integrates the dashpot (damper 1) only: a springpot has no ODE for GSL "
+                          "(compare --memory 1 with --memory 2 instead)");
+    for (i = 0; i < sizeof own_steps / sizeof own_steps[0]; i++)
+        if ((value = typed_value(t, o, own_steps[i])))
+            return bad_option(own_steps[i], value, "--reference takes GSL's steps (to --rtol), not the model's");
+    if (o->p.law != 2 && o->p.g1_nodes == 0) {
+        if ((value = typed_value(t, o, "--law")))
+            return bad_option("--law", value,
+                              "--reference solves the continuous law: hertz, or g1 and g1x with --g1-nodes N > 0 "
+                              "(with N the steps since onset the G1 laws tend to hertz as dt_max shrinks)");
+        o->p.law = 2; /* the default law's limit, which the reference solves */
+    }
+    return 0;
+}
+
+/* The run's size (the library's limits on steps and rows), and the rows'
+ * spacing: --output-interval only with --csv. */
+static int check_run(const option_table *t, options *o)
+{
+    char why[FC_MESSAGE_SIZE];
+    const char *typed = typed_value(t, o, "--output-interval");
+    fc_status status;
+    if (!o->csv && typed)
+        return bad_option("--output-interval", typed, "the time between the rows of --csv, which is not given");
+    o->interval = !o->csv ? FC_NO_ROWS : typed ? o->output_interval : fc_default_output_interval(&o->p);
+    status = o->reference ? run_rows_check(&o->p, o->interval, 0.0, why, sizeof why)
+                          : fc_run_check(&o->p, o->interval, why, sizeof why);
+    return status == FC_OK ? 0 : bad_model(t, o, why);
+}
+
 /* Returns 0, 2 for bad options, or -1 after --help or --list-options. */
 static int parse(int argc, char **argv, const option_table *t, options *o)
 {
     int i;
     size_t k;
-    char warning[FC_MESSAGE_SIZE];
+    char warning[FC_MESSAGE_SIZE], why[FC_MESSAGE_SIZE];
     for (i = 1; i < argc; i++) {
         char name[64];
         const char *value = NULL, *eq = strchr(argv[i], '=');
@@ -332,6 +389,14 @@ static int parse(int argc, char **argv, const option_table *t, options *o)
             value = argv[++i];
         else
             return bad_option(name, "", "needs a value");
+        if (o->typed[opt - t->list]) {
+            if (opt->kind == FLAG)
+                fprintf(stderr, PROGRAM ": %s given twice: give each option once (see --help)\n", name);
+            else
+                fprintf(stderr, PROGRAM ": %s given twice ('%s', then '%s'): give each option once (see --help)\n",
+                        name, o->typed[opt - t->list], value);
+            return 2;
+        }
         if (set_option(o, opt, value) != 0)
             return 2;
         o->typed[opt - t->list] = value;
@@ -341,7 +406,11 @@ static int parse(int argc, char **argv, const option_table *t, options *o)
             return bad_option("--height", typed_value(t, o, "--height"), "give --height or --v, not both");
         o->p.v = fc_drop_velocity(o->height);
     }
-    if (check_model(t, o) != 0)
+    if (fc_params_check(&o->p, why, sizeof why) != FC_OK)
+        return bad_model(t, o, why);
+    if (check_method(t, o) != 0)
+        return 2;
+    if (check_run(t, o) != 0)
         return 2;
     if (fc_params_warning(&o->p, warning, sizeof warning))
         fprintf(stderr, PROGRAM ": warning: %s\n", warning);
@@ -513,75 +582,135 @@ static void print_table(const options *o, const fc_result *r, double cpu_seconds
 
 /* ------------------------------------------------------------ the solves */
 
+/* Set by Ctrl-C: the solve stops at its next progress call. */
+static volatile sig_atomic_t interrupted;
+
+static void interrupt(int sig)
+{
+    if (interrupted) { /* a second Ctrl-C: at once */
+        signal(sig, SIG_DFL);
+        raise(sig);
+    }
+    interrupted = 1;
+}
+
+/* The progress line on a terminal, once the solve has taken a few seconds. */
+#define PROGRESS_AFTER 2.0
+#define PROGRESS_EVERY 0.5
+
 typedef struct {
-    double t_end, shown;
-    int impacts;
+    const options *o;
+    const series *rows; /* the reference's, which stops when they run out */
+    int shown;          /* a line is on the terminal */
+    double start, next; /* CPU seconds: the solve's start, the next line (0: no line) */
 } progress_line;
 
-static void show_progress(void *ctx, double t, int64_t steps, int64_t impacts)
+static int watch(void *ctx, double t, int64_t steps, int64_t impacts)
 {
     progress_line *line = ctx;
-    if (cpu_seconds() - line->shown < 0.5)
-        return;
-    line->shown = cpu_seconds();
-    fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " steps, %" PRId64 " of %d impacts   ", t,
-            line->t_end, steps, impacts, line->impacts);
+    if (line->next > 0.0 && cpu_seconds() >= line->next) {
+        line->next = cpu_seconds() + PROGRESS_EVERY;
+        line->shown = 1;
+        fprintf(stderr, "\r  t = %.6g s of at most %.6g s, %" PRId64 " %s, %" PRId64 " of %d impacts (Ctrl-C stops)   ",
+                t, line->o->p.t_end, steps, line->o->reference ? "evaluations" : "steps", impacts,
+                line->o->p.impacts);
+    }
+    return interrupted || (line->rows && line->rows->failed);
 }
 
-static int solve_model(const options *o, double interval, fc_result *r)
+static void watch_start(progress_line *line, const options *o, const series *rows)
+{
+    line->o = o;
+    line->rows = rows;
+    line->shown = 0;
+    /* not otherwise: --repeat times the solve, and a clock read costs about 0.6 us */
+    line->next = !o->quiet && !o->json && isatty(STDERR_FILENO) ? cpu_seconds() + PROGRESS_AFTER : 0.0;
+}
+
+static void watch_end(const progress_line *line)
+{
+    if (line->shown)
+        fprintf(stderr, "\n");
+}
+
+/* Reports a solve that did not finish; 130 when Ctrl-C stopped it, else 1. */
+static int failed(const fc_outcome *outcome, const char *why)
+{
+    if (outcome->status == FC_ESTOPPED && interrupted) {
+        fprintf(stderr, PROGRAM ": interrupted (Ctrl-C) at t = %.6g s: nothing written\n", outcome->t);
+        return 130;
+    }
+    fprintf(stderr, PROGRAM ": %s\n", why);
+    return 1;
+}
+
+static int solve_model(const options *o, fc_result *r)
 {
     char why[FC_MESSAGE_SIZE];
-    progress_line line = {o->p.t_end, 0.0, o->p.impacts};
-    int progress = !o->quiet && !o->json && isatty(STDERR_FILENO);
-    if (progress) /* not otherwise: --repeat times the solve, and a clock read costs about 0.6 us */
-        line.shown = cpu_seconds();
-    if (fc_run_with_progress(&o->p, interval, progress ? show_progress : NULL, &line, r, why, sizeof why) != FC_OK) {
-        fprintf(stderr, PROGRAM ": %s\n", why);
-        return -1;
-    }
-    if (progress && r->outcome.steps >= 65536)
-        fprintf(stderr, "\n");
-    return 0;
+    progress_line line;
+    fc_status status;
+    watch_start(&line, o, NULL);
+    status = fc_run_with_progress(&o->p, o->interval, watch, &line, r, why, sizeof why);
+    watch_end(&line);
+    return status == FC_OK ? 0 : failed(&r->outcome, why);
 }
 
-static int solve_reference(const options *o, double interval, fc_result *r)
+static int solve_reference(const options *o, fc_result *r)
 {
     reference_result ref;
     impact_list impacts = {NULL, 0, 0};
     series rows = {NULL, 0, 0, 0};
     char why[FC_MESSAGE_SIZE];
-    int status = reference_solve(&o->p, o->rtol, interval, interval >= 0.0 ? keep : NULL, &rows, &impacts, &ref,
-                                 why, sizeof why);
+    progress_line line;
+    int status;
+    memset(&ref, 0, sizeof ref);
+    watch_start(&line, o, &rows);
+    status = reference_solve(&o->p, o->rtol, o->interval, o->interval >= 0.0 ? keep : NULL, &rows, watch, &line,
+                             &impacts, &ref, why, sizeof why);
+    watch_end(&line);
     memset(r, 0, sizeof *r);
     r->per_impact = impacts.list;
     r->n_impacts = impacts.n;
     r->rows = rows.rows;
     r->n_rows = rows.n;
-    if (status != 0 || rows.failed) {
-        fprintf(stderr, PROGRAM ": %s\n", status != 0 ? why : "out of memory for the --csv series");
-        return -1;
-    }
     r->outcome = ref.outcome;
-    return 0;
+    if (rows.failed) {
+        fprintf(stderr, PROGRAM ": %s\n", rows.n < (size_t)FC_ROWS_MAX ? "out of memory for the --csv series"
+                : "--output-interval: the time series reached the rows a run keeps; raise --output-interval, or "
+                  "lower --t-end or --impacts");
+        return 1;
+    }
+    return status == 0 ? 0 : failed(&ref.outcome, why);
 }
 
-/* One solve, or --repeat of them; returns the median CPU time of the solve
- * alone, or -1. The result is the last solve's. */
-static double solve(const options *o, double interval, fc_result *r)
+/* One solve, or --repeat of them; *seconds: the median CPU time of the
+ * solve alone. The result is the last solve's. Returns 0, or the exit
+ * status after a message. */
+static int solve(const options *o, fc_result *r, double *seconds)
 {
-    double *times = malloc((size_t)o->repeat * sizeof *times), seconds = -1.0;
-    int i, status = times ? 0 : -1;
+    double *times = malloc((size_t)o->repeat * sizeof *times);
+    int i, status = 0;
+    struct sigaction on_interrupt, before;
+    if (!times) {
+        fprintf(stderr, PROGRAM ": out of memory\n");
+        return 1;
+    }
+    memset(&on_interrupt, 0, sizeof on_interrupt);
+    on_interrupt.sa_handler = interrupt;
+    sigemptyset(&on_interrupt.sa_mask);
+    sigaction(SIGINT, &on_interrupt, &before);
+    memset(r, 0, sizeof *r);
     for (i = 0; i < o->repeat && status == 0; i++) {
         double t0 = cpu_seconds();
-        if (i > 0)
-            fc_result_free(r);
-        status = o->reference ? solve_reference(o, interval, r) : solve_model(o, interval, r);
+        fc_result_free(r);
+        status = o->reference ? solve_reference(o, r) : solve_model(o, r);
         times[i] = cpu_seconds() - t0;
     }
+    sigaction(SIGINT, &before, NULL);
     if (status == 0)
-        seconds = median(times, o->repeat);
+        *seconds = median(times, o->repeat);
     free(times);
-    return seconds;
+    return status;
 }
 
 int main(int argc, char **argv)
@@ -589,7 +718,7 @@ int main(int argc, char **argv)
     option_table table;
     options o;
     fc_result r;
-    double interval, seconds;
+    double seconds = 0.0;
     int status;
     memset(&o, 0, sizeof o);
     fc_params_default(&o.p);
@@ -599,11 +728,10 @@ int main(int argc, char **argv)
     status = parse(argc, argv, &table, &o);
     if (status != 0)
         return status < 0 ? 0 : status;
-    interval = !o.csv ? FC_NO_ROWS : typed_value(&table, &o, "--output-interval") ? o.output_interval
-                                                                            : fc_default_output_interval(&o.p);
-    seconds = solve(&o, interval, &r);
-    status = seconds < 0.0 || (o.csv && write_csv(o.csv, r.rows, r.n_rows) != 0);
-    if (!status) {
+    status = solve(&o, &r, &seconds);
+    if (status == 0 && o.csv && write_csv(o.csv, r.rows, r.n_rows) != 0)
+        status = 1;
+    if (status == 0) {
         if (o.json)
             print_json(&o, &r, seconds);
         else

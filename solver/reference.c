@@ -151,8 +151,13 @@ static void sample_state(const ode *o, double t, const double y[4], reference_sa
     sample(ctx, t, force(o, y[0]), y[0] + y[2], y[0] > 0.0 ? y[0] : 0.0, y[2], y[1], y[3]);
 }
 
+/* The brackets between two calls of the progress callback: a few
+ * milliseconds of work at most. */
+#define BRACKETS_PER_PROGRESS 64
+
 int reference_solve(const fc_params *params, double rtol, double out_dt, reference_sample sample, void *ctx,
-                    impact_list *per_impact, reference_result *result, char *msg, size_t len)
+                    fc_progress progress, void *progress_ctx, impact_list *per_impact, reference_result *result,
+                    char *msg, size_t len)
 {
     fc_outcome *r = &result->outcome;
     contact_params model, *p = &model;
@@ -163,8 +168,8 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
     gsl_odeiv2_system sys;
     double scale[4], x_ref, t_ref, x_small, bracket, y[4], y1[4], t = 0.0;
     double v_onset = v0, t_onset = 0.0, E_diss_onset = 0.0, F_peak_contact = 0.0;
-    long k = 1;
-    int in_contact, out_of_memory = 0;
+    long k = 1, brackets = 0;
+    int in_contact, out_of_memory = 0, stopped = 0;
     gsl_error_handler_t *previous = gsl_set_error_handler_off();
 
     fc_model_params(params, &model);
@@ -219,7 +224,7 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
     in_contact = y[0] >= 0.0 && (v0 > 0.0 || (v0 == 0.0 && o.accel > 0.0));
     if (sample)
         sample_state(&o, t, y, sample, ctx);
-    while (in.status == GSL_SUCCESS && !out_of_memory) {
+    while (in.status == GSL_SUCCESS && !out_of_memory && !stopped) {
         double t1;
         int event = 0;
         r->stop = r->impacts >= params->impacts ? FC_STOP_IMPACTS
@@ -278,6 +283,8 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
         }
         t = t1;
         memcpy(y, y1, sizeof y);
+        stopped = progress && ++brackets % BRACKETS_PER_PROGRESS == 0
+                  && progress(progress_ctx, t, o.evaluations, r->impacts) != 0;
     }
     if (sample)
         sample_state(&o, t, y, sample, ctx);
@@ -288,11 +295,15 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
     r->x2 = y[2];
     r->E_diss = y[3];
     r->steps = o.evaluations;
-    r->status = in.status == GSL_SUCCESS && !out_of_memory ? FC_OK : FC_EFAIL;
+    r->status = stopped ? FC_ESTOPPED : in.status == GSL_SUCCESS && !out_of_memory ? FC_OK : FC_EFAIL;
     gsl_odeiv2_driver_free(in.driver);
     gsl_set_error_handler(previous);
     if (out_of_memory) {
         snprintf(msg, len, "reference: out of memory for the per-impact figures");
+        return -1;
+    }
+    if (stopped) {
+        snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", t);
         return -1;
     }
     if (in.status != GSL_SUCCESS) {

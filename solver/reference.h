@@ -27,9 +27,12 @@ typedef void (*reference_sample)(void *ctx, double t, double F, double x, double
  * impact to *impacts. Events are located within brackets of 1/64 of the
  * contact's time scale, whatever the output: the samples, every out_dt and at
  * every onset and separation (out_dt = 0: at every bracket), are integrated
- * from the last bracket and change no figure. Returns 0, or -1 with a
- * message when GSL fails or memory runs out. */
+ * from the last bracket and change no figure. `progress` (or NULL) is
+ * called now and then as the library's runs call it; when it asks to stop,
+ * the outcome's status is FC_ESTOPPED. Returns 0, or -1 with a message when
+ * GSL fails, memory runs out or the run was stopped. */
 int reference_solve(const fc_params *p, double rtol, double out_dt, reference_sample sample, void *ctx,
-                    impact_list *per_impact, reference_result *result, char *msg, size_t len);
+                    fc_progress progress, void *progress_ctx, impact_list *per_impact, reference_result *result,
+                    char *msg, size_t len);
 
 #endif

@@ -8,8 +8,12 @@ void series_add(series *s, const double row[FC_COLUMNS])
 {
     if (s->failed || (s->n > 0 && !(row[FC_T] > s->rows[(s->n - 1) * FC_COLUMNS + FC_T])))
         return;
+    if (s->n >= (size_t)FC_ROWS_MAX) {
+        s->failed = 1;
+        return;
+    }
     if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 1024;
+        size_t cap = s->cap ? (s->cap < (size_t)FC_ROWS_MAX / 2 ? 2 * s->cap : (size_t)FC_ROWS_MAX) : 1024;
         double *grown = realloc(s->rows, cap * FC_COLUMNS * sizeof *grown);
         if (!grown) {
             s->failed = 1;

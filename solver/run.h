@@ -21,8 +21,13 @@ typedef struct {
 } series;
 
 /* Appends a row, unless it repeats the last one's time (an event on an
- * output time). */
+ * output time); at most FC_ROWS_MAX of them. */
 void series_add(series *s, const double row[FC_COLUMNS]);
+
+/* FC_OK, or FC_EINVAL and a message when a time series with rows every
+ * `interval` (0: every internal step, of which the run takes at least
+ * `steps`) would hold more than FC_ROWS_MAX rows. */
+fc_status run_rows_check(const fc_params *p, double interval, double steps, char *msg, size_t len);
 
 /* The model's parameters of a run. */
 void fc_model_params(const fc_params *p, contact_params *q);

@@ -22,9 +22,15 @@ enum contact_scheme {
 
 /* Events at which contact_advance_until can stop, as bits. */
 enum contact_event {
-    CONTACT_ONSET = 1,      /* the striker meets the specimen */
-    CONTACT_SEPARATION = 2  /* the force returns to zero: an impact has ended */
+    CONTACT_ONSET = 1,       /* the striker meets the specimen */
+    CONTACT_SEPARATION = 2,  /* the force returns to zero: an impact has ended */
+    /* Out of contact a recovering springpot's flight is one advance of many
+     * steps: stop after each of them, or after CONTACT_PAUSE_STEPS of them
+     * (for a caller that retraces the steps, or reports progress). */
+    CONTACT_FLIGHT_STEP = 4,
+    CONTACT_PAUSE = 8
 };
+#define CONTACT_PAUSE_STEPS 4096
 
 enum contact_damper {
     CONTACT_DAMPER_DASHPOT = 1,  /* F = c x2' */

@@ -3,24 +3,26 @@
 The model runs in-process on its C library:
 
     import fraccontact
-    r = fraccontact.impact(height=0.020, c=5000.0)      # r.F_peak, r.eps, r.per_impact
-    r = fraccontact.impact(damper=2, damper_order=0.5, c_alpha=3e5)   # a springpot
-    a = fraccontact.impacts(c=numpy.linspace(3e3, 9e3, 100))   # arrays, one library call
-    s = fraccontact.simulate(output_interval=1e-5)       # s["t"], s["F"], ...
+    r = fraccontact.impact(height=0.020, c=5000.0)      # a Run: r.F_peak, r.eps, r.end.x2, r.per_impact
+    r = fraccontact.impact(damper="springpot", damper_order=0.5, c_alpha=3e5)
+    a = fraccontact.impacts(c=numpy.linspace(3e3, 9e3, 100))   # a Run of arrays, one library call
+    s = fraccontact.simulate(output_interval=1e-5)       # a Series: s.t, s.F, ..., s.run
     fraccontact.fmu_path()                               # the FMI 2.0 FMU to co-simulate
 
-The console command `fraccontact` (python -m fraccontact) runs the h20
-example, fits, sweeps, co-simulations and the reports (fraccontact --help).
+Results read by attribute or key alike (r.F_peak, r["F_peak"]); their
+fields are listed in fraccontact.model's docstring. The console command
+`fraccontact` (python -m fraccontact) runs the h20 example, fits, sweeps,
+co-simulations and the reports (fraccontact --help).
 """
 
 import os
 import pathlib
 
-from .model import (Impact, Run, defaults, drop_velocity, impact, impacts, memory_kernel, parameters, simulate,
-                    warning)
+from .model import (End, Impact, ParameterWarning, Run, Series, defaults, drop_velocity, impact, impacts,
+                    memory_kernel, parameters, simulate, warning)
 
-__all__ = ["Impact", "Run", "defaults", "drop_velocity", "fmu_path", "impact", "impacts", "memory_kernel",
-           "parameters", "simulate", "warning"]
+__all__ = ["End", "Impact", "ParameterWarning", "Run", "Series", "defaults", "drop_velocity", "fmu_path", "impact",
+           "impacts", "memory_kernel", "parameters", "simulate", "warning"]
 
 _HERE = pathlib.Path(__file__).resolve().parent
 _FMU_VARIABLES = {"fraccontact": "FRACCONTACT_FMU", "striker": "STRIKER_FMU"}

@@ -13,7 +13,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 SUFFIX = {"win32": ".dll", "darwin": ".dylib"}.get(sys.platform, ".so")
 PREFIX = "" if sys.platform == "win32" else "lib"
 
-FC_OK, FC_EINVAL, FC_EFAIL, FC_ENOMEM = 0, 1, 2, 3
+FC_OK, FC_EINVAL, FC_EFAIL, FC_ENOMEM, FC_ESTOPPED = 0, 1, 2, 3, 4
 STOPS = {1: "impacts", 2: "t_end", 3: "receding"}
 NO_ROWS, EVERY_STEP, DEFAULT_ROWS = -1.0, 0.0, -2.0
 COLUMNS = ("t", "F", "x", "x1", "x2", "v", "E_diss")
@@ -101,10 +101,19 @@ for _struct, _size in ((Params, LIB.fc_params_size()), (Outcome, LIB.fc_outcome_
 
 LIB.fc_params_default.argtypes = [ctypes.POINTER(Params)]
 LIB.fc_params_check.argtypes = [ctypes.POINTER(Params), ctypes.c_char_p, ctypes.c_size_t]
-LIB.fc_params_warning.argtypes = [ctypes.POINTER(Params), ctypes.c_char_p, ctypes.c_size_t]
+# by address: a batch's cases are looked at in place
+LIB.fc_params_warning.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t]
+LIB.fc_run_check.argtypes = [ctypes.POINTER(Params), ctypes.c_double, ctypes.c_char_p, ctypes.c_size_t]
 LIB.fc_default_output_interval.argtypes = [ctypes.POINTER(Params)]
 LIB.fc_run.argtypes = [ctypes.POINTER(Params), ctypes.c_double, ctypes.POINTER(Result), ctypes.c_char_p,
                        ctypes.c_size_t]
+# Called now and then during a run (fc_progress) or a batch (fc_batch_progress); nonzero stops it.
+PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_int64, ctypes.c_int64)
+BATCH_PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_size_t)
+LIB.fc_run_with_progress.argtypes = [ctypes.POINTER(Params), ctypes.c_double, PROGRESS, ctypes.c_void_p,
+                                     ctypes.POINTER(Result), ctypes.c_char_p, ctypes.c_size_t]
+LIB.fc_run_batch_with_progress.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, BATCH_PROGRESS,
+                                           ctypes.c_void_p]
 LIB.fc_result_free.argtypes = [ctypes.POINTER(Result)]
 LIB.fc_run_batch.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
 LIB.fc_memory_kernel.restype = ctypes.c_size_t
