@@ -107,3 +107,19 @@ def stopping_distance(HIC, v, window=WINDOWS["HIC15"]):
     if v / (a * STANDARD_GRAVITY) > window:
         a = (HIC / window) ** 0.4
     return v * v / (2.0 * a * STANDARD_GRAVITY)
+
+
+def least_stopping_distance(HIC, v, window=WINDOWS["HIC15"]):
+    """The shortest distance [m] in which any pulse whose HIC over window is
+    HIC stops from v [m/s]: three quarters of the square pulse's. HIC over
+    [0, t] caps the speed lost by t at (HIC t^1.5)^0.4 g, and the pulse
+    a = 0.6 HIC^0.4 t^-0.4 [g] loses exactly that at every t, with HIC no
+    more than HIC over any other window (t^0.6 is subadditive): it stops
+    after the square pulse's T = (v/g)^(5/3) HIC^(-2/3), having travelled
+    3/8 v T against the square pulse's v T/2. ValueError when T > window
+    (the bound then needs the windows that do not start at 0)."""
+    duration = (v / STANDARD_GRAVITY) ** (5.0 / 3.0) * HIC ** (-2.0 / 3.0) if HIC > 0 and v > 0 else -1.0
+    if not 0 < duration <= window:
+        raise ValueError(f"HIC = {HIC}, v = {v}: the pulse would last {duration:g} s, beyond window = {window} s "
+                         "(or HIC, v are not > 0)")
+    return 0.375 * v * duration
