@@ -17,8 +17,8 @@ FASCIA = 0
 T_END = 0.5            # s: several contact times
 SAMPLE = 1e-5          # s
 RTOL = 1e-10
-# The beam rings on the fascia's contact with a period near a millisecond:
-# no step may jump over a bounce.
+# The light beam's bounces on the barrier are short against the body's
+# push: no step may be long enough to jump over one unseen.
 MAX_STEP = 2e-4
 
 

@@ -100,7 +100,11 @@ class Chain:
     def rhs(self, t, y):
         dy = np.zeros(self.size)
         force = np.zeros(len(self.m))
-        pairs = [(link, link.k * du + link.c * dv) for link in self.links for du, dv in [self.relative(y, link)]]
+        pairs = []
+        for link in self.links:
+            du, dv = self.relative(y, link)
+            pairs.append((link, link.k * du + link.c * dv))
+            dy[self.E_LINKS] += link.c * dv * dv
         for index, contact in enumerate(self.contacts):
             F = contact_force(contact, self.x1(y, index))
             pairs.append((contact, F))
@@ -113,8 +117,6 @@ class Chain:
                 dy[self.IMPULSE] -= F
             else:
                 force[part.j] += F
-        for link in self.links:
-            dy[self.E_LINKS] += link.c * self.relative(y, link)[1] ** 2
         dy[self.U] = y[self.V]
         dy[self.V] = force / self.m
         return dy

@@ -22,8 +22,8 @@ SKIN, HARD = 0, 1
 T_END = 0.035          # s: the head has left the panel before (solve checks it)
 SAMPLE = 1e-5          # s: 100 kHz, ten times CFC 1000's sample rate floor
 RTOL = 1e-10
-# The hard point's contact lasts a few tenths of a millisecond: no step may
-# be long enough to jump over it unseen.
+# The hard point's contact is far shorter than the head's: no step may be
+# long enough to jump over it unseen.
 MAX_STEP = 1e-4
 NO_HARD_POINT = math.inf
 
