@@ -48,7 +48,7 @@ def _run(headform, gap0, bonnet, t_end):
 
 def solve(headform=ADULT, gap0=NO_HARD_POINT, bonnet=Bonnet(), t_end=T_END):
     """The impact sampled every SAMPLE seconds: t, a (the head's deceleration,
-    m/s^2), F_skin, F_hard, u_head, u_panel; figures (crash.figures after
+    m/s^2), a_g (the same in g, unfiltered), F_skin, F_hard, u_head, u_panel; figures (crash.figures after
     CFC 1000) and figures_raw (unfiltered); panel_deflection and head_travel
     (their largest values, m); the contact events; balances (the largest
     energy and momentum residuals, relative)."""
@@ -59,7 +59,7 @@ def solve(headform=ADULT, gap0=NO_HARD_POINT, bonnet=Bonnet(), t_end=T_END):
         raise RuntimeError(f"the head is still on the panel at t_end = {t_end} s: run longer")
     a = s["F"][SKIN] / headform.m
     energy, momentum = run.balances(t)
-    return dict(t=t, a=a, F_skin=s["F"][SKIN], F_hard=s["F"][HARD] if len(chain.contacts) > 1 else 0 * t,
+    return dict(t=t, a=a, a_g=crash.in_g(a), F_skin=s["F"][SKIN], F_hard=s["F"][HARD] if len(chain.contacts) > 1 else 0 * t,
                 u_head=s["u"][HEAD], u_panel=s["u"][PANEL],
                 figures=crash.figures(t, a), figures_raw=crash.figures(t, a, cfc=False),
                 panel_deflection=float(s["u"][PANEL].max()), head_travel=float(s["u"][HEAD].max()),
