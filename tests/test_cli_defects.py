@@ -368,7 +368,7 @@ HINTS = [
 def test_a_wrong_impulse_is_blamed_on_what_is_wrong(command, monkeypatch, tmp_path, curve, name, contents, says,
                                                     not_says):
     for model_call in ("run", "force_series", "figures", "series"):
-        monkeypatch.setattr(fit, model_call, no_run)
+        monkeypatch.setattr(fit.runs, model_call, no_run)
     path = tmp_path / "curve.csv"
     path.write_text(contents(*curve))
     status, out, err = command("fit", "--curve", path, "--height", "0.020", "--m", M)
