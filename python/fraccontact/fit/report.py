@@ -9,6 +9,7 @@ from ..reports import pyplot, save, significant, with_error
 from . import runs
 from .drops import K_CAP
 
+
 def parameters_label(result):
     """'k = ... , c = ...' (or c_alpha, alpha) with errors, for a legend."""
     parts = [f"k = {with_error(result['k'], result.get('sigma_k'), 'N/m^1.5')}"]
