@@ -1,4 +1,4 @@
-"""Material identification (fraccontact fit, fraccontact/fit.py): known k, c
+"""Material identification (fraccontact fit, fraccontact/fit/): known k, c
 (and the contact onset t0 of a curve) are recovered from data the model made,
 with and without noise; unreachable pairs are refused with a message; the
 paper's h20 row is fitted; hostile files and arguments get one line and exit
@@ -150,8 +150,8 @@ def refuse(monkeypatch, capsys):
     before any solve."""
     def model_ran(*args, **kwargs):
         raise AssertionError("the model ran before the input was refused")
-    for name in ("run", "force_series", "figures", "series"):  # every way fit.py calls the model
-        monkeypatch.setattr(fit, name, model_ran)
+    for name in ("run", "force_series", "figures", "series"):  # every way the fit calls the model (fit/runs.py)
+        monkeypatch.setattr(fit.runs, name, model_ran)
 
     def fit_main(*args):
         try:

@@ -1,11 +1,14 @@
 """The reports under docs/, one module each with main(argv, prog):
-fraccontact report NAME (scripts/report NAME from the source tree)."""
+fraccontact report NAME (scripts/report NAME from the source tree). Here,
+what they share (fraccontact fit's output too): the command line, and how
+numbers are written and figures drawn."""
 
 import argparse
+import math
 import os
 import pathlib
 
-from .. import fmu_path, solver
+from .. import atomic, fmu_path, solver
 from ..options import OneLineParser
 
 
@@ -66,3 +69,37 @@ def parse(p, argv, check=None):
         check(p, args)
     make_folder(p, args.out)
     return args
+
+
+def significant(x, digits):
+    """x to that many significant digits, trailing zeros kept, 'e8' for 'e+08'."""
+    mantissa, _, exponent = f"{x:#.{digits}g}".partition("e")
+    return mantissa.rstrip(".") + (f"e{int(exponent)}" if exponent else "")
+
+
+def with_error(value, sigma, unit):
+    """'value ± sigma unit', the value to the second significant digit of
+    sigma (its further digits are noise); 6 digits when there is no sigma."""
+    if sigma is None or not sigma > 0:
+        return f"{significant(value, 6)} {unit}".rstrip()
+    magnitude = math.floor(math.log10(abs(value))) if value else math.floor(math.log10(sigma))
+    digits = max(magnitude - math.floor(math.log10(sigma)) + 2, 1)
+    return f"{significant(value, digits)} ± {significant(sigma, 2)} {unit}".rstrip()
+
+
+def pyplot():
+    """matplotlib.pyplot drawing to files only (the Agg backend: no display
+    needed), imported on first use so that a command that may not plot
+    runs without matplotlib."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def save(fig, path, dpi=100, rect=None):
+    """The figure laid out (tight, within rect) and written whole or not at
+    all, without matplotlib's version in its metadata: the file changes
+    only when the figure does."""
+    fig.tight_layout(rect=rect)
+    atomic.save_figure(fig, path, dpi=dpi, metadata={"Software": None})

@@ -48,12 +48,10 @@ from scipy.special import gamma
 
 import differint.differint as differint
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from .. import atomic, fit, fmu, model, reports, solver
+from ..scipy_contact import solve_drop
 
-from .. import atomic, fit, fmu, model, reports, solver  # noqa: E402
-from ..scipy_contact import solve_drop  # noqa: E402
+plt = reports.pyplot()
 
 TARGET = 1e-6
 # Section 4: (label, law, dt_max, impacts in one fraccontact.impacts call,
@@ -353,8 +351,7 @@ def plot_precision(path, r):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
     fig.suptitle("Work against precision (gray: 1e-6; ringed: the cheapest setting meeting it)")
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path, rect=(0, 0.08, 1, 1))
 
 
 def precision(root, program, bench, fmu_file, out):

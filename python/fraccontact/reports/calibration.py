@@ -44,9 +44,7 @@ def throughput(out, workers, n):
 
 
 def plot(path, paper_rows, fitted_rows):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = reports.pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
     spec = [("F_peak", 1, "peak force F_peak [N]"), ("eps", 1, "restitution coefficient eps"),
             ("t_contact", 1e3, "contact time [ms]"), ("x2_end", 1e6, "permanent indentation [um]")]
@@ -61,8 +59,7 @@ def plot(path, paper_rows, fitted_rows):
         ax.grid(alpha=0.3)
     axes.flat[0].legend(fontsize=8)
     fig.suptitle(f"Drop-height sweep, 5 to 100 mm (m = {PAPER['m']:g} kg, Hertz law)")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 # The springpot (issue 12, item 7): the h20 row cannot identify k, c_alpha and alpha.
@@ -164,7 +161,7 @@ def family_section(out):
         E_s = modulus(mb["k"])
         pr = by_alpha.get(mb["alpha"])
         lines.append(f"| {mb['alpha']:.2f} | {mb['k']:.4g} | {mb['c_alpha']:.4g} | "
-                     f"{'none' if E_s is None else fit.significant(E_s / 1e9, 3)} | {pr['t_contact'] * 1e3:.4f} | "
+                     f"{'none' if E_s is None else reports.significant(E_s / 1e9, 3)} | {pr['t_contact'] * 1e3:.4f} | "
                      f"{pr['x2_end'] * 1e6:.2f} | {pr['F'][0]:.1f} | {pr['F'][-1]:.1f} | {pr['eps'][0]:.4f} | "
                      f"{pr['eps'][-1]:.4f} |")
     lines += ["", f"Below alpha = {members[-1]['alpha']:.2f} the table ends: the family's k rises without bound as "
@@ -212,10 +209,8 @@ def family_section(out):
 
 
 def plot_family(path, members, predictions, alpha_min, alpha_E, heights):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.ticker  # noqa: F401 (matplotlib.ticker below)
+    plt = reports.pyplot()
+    import matplotlib.ticker
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
     ax = axes[0, 0]
     alphas = [mb["alpha"] for mb in members]
@@ -244,8 +239,7 @@ def plot_family(path, members, predictions, alpha_min, alpha_E, heights):
     axes[1, 1].legend(fontsize=7)
     for ax in axes.flat:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def synthetic_drops(params, heights, repeats, noise_F, noise_eps, seed, sigmas=False):
@@ -311,10 +305,10 @@ def identifiability_section(base, truth_member):
         cells = []
         for name in ("k", "c_alpha", "alpha"):
             if "exact" in label:     # no noise: the standard errors measure the model's 1e-6, show the deviation
-                cells.append(f"{fit.significant(r[name], 6)} (relative error {r[name] / truth[name] - 1:+.1e})")
+                cells.append(f"{reports.significant(r[name], 6)} (relative error {r[name] / truth[name] - 1:+.1e})")
                 continue
             sigma = r[f"sigma_{name}"]
-            cells.append(f"{fit.with_error(r[name], sigma, '')} ({(r[name] - truth[name]) / sigma:+.1f})")
+            cells.append(f"{reports.with_error(r[name], sigma, '')} ({(r[name] - truth[name]) / sigma:+.1f})")
         lines.append(f"| {label} | identified | " + " | ".join(cells) + f" | {r['condition']:.3g} | {seconds:.1f} s |")
     lines += ["", "One drop test's two numbers cannot identify three parameters, and repeating the test adds "
               "scatter, not a direction (the Jacobian keeps rank 2). A second height does, through the peak force's "

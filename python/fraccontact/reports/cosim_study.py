@@ -16,15 +16,13 @@ import pathlib
 
 import numpy as np
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from .. import atomic, hertz, impact, model, reports  # noqa: E402
-from ..cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,  # noqa: E402
+from .. import atomic, hertz, impact, model, reports
+from ..cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,
                      fmu_paths, monolithic, spring_reference)
-from ..progress import progress  # noqa: E402
-from ..ssp import run_fmpy, run_libcosim, ssp_path  # noqa: E402
+from ..progress import progress
+from ..ssp import run_fmpy, run_libcosim, ssp_path
+
+plt = reports.pyplot()
 
 STEPS = [float(f"{h:.3g}") for h in np.logspace(-6, -3, 31)]
 DECADES = (1e-6, 1e-5, 1e-4, 1e-3)
@@ -189,8 +187,7 @@ def plot(path, results, forced, traces):
         ax.grid(alpha=0.3, which="both")
     axes.flat[4].legend(fontsize=8)
     fig.suptitle("Striker FMU + contact FMU against the monolithic drop test (h20)")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def ssp_runs(ssp, contact, striker):

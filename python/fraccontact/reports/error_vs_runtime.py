@@ -16,13 +16,11 @@ import time
 
 import numpy as np
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from .. import atomic, model, reports, solver
+from ..progress import progress
+from ..scipy_contact import solve_drop
 
-from .. import atomic, model, reports, solver  # noqa: E402
-from ..progress import progress  # noqa: E402
-from ..scipy_contact import solve_drop  # noqa: E402
+plt = reports.pyplot()
 
 H20 = model.defaults()
 K, C, M, V0 = H20["k"], H20["c"], H20["m"], H20["v"]
@@ -186,8 +184,7 @@ def plot(path, results, adaptive_rows, scipy_rows, gsl_rows):
     axes.flat[-1].legend(handles, labels, loc="center", fontsize=9)
     fig.suptitle("Error against CPU time, h20 drop test (fixed internal steps 1e-5 s ... 1.2e-9 s; "
                  "gray line: 1e-6)")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def fmt(x):

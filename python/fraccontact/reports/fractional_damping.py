@@ -17,13 +17,12 @@ import time
 
 import numpy as np
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.ticker  # noqa: E402
+import matplotlib.ticker
 
-from .. import atomic, model, reports, solver  # noqa: E402
-from ..fmu import Slave, unpacked  # noqa: E402
+from .. import atomic, model, reports, solver
+from ..fmu import Slave, unpacked
+
+plt = reports.pyplot()
 
 H20 = model.defaults()
 M, V0, C = H20["m"], H20["v"], H20["c"]
@@ -469,8 +468,7 @@ def plot_curves(path, series, omega):
     ax_t.legend(fontsize=8)
     fig.suptitle(f"h20 drop test with a springpot, c_alpha = c omega^(1-alpha), c = {C:g} N s/m, "
                  f"omega = {omega:.0f} rad/s")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def plot_heights(path, h):
@@ -495,8 +493,7 @@ def plot_heights(path, h):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.suptitle(f"Drop heights 5 to 100 mm (m = {M:g} kg, k = {H20['k']:.4g} N/m^1.5, n = 1.5)")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def plot_recovery(path, rec, sc):
@@ -532,8 +529,7 @@ def plot_recovery(path, rec, sc):
              title="Second contact under gravity: it begins where x = x2")
     ax_s.grid(alpha=0.3)
     ax_s.legend(fontsize=8)
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def plot_cost(path, rows, sizes, bench_json):
@@ -563,8 +559,7 @@ def plot_cost(path, rows, sizes, bench_json):
     for ax in (ax_c, ax_s):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 def plot_memory(path, k, agree, lad):
@@ -601,8 +596,7 @@ def plot_memory(path, k, agree, lad):
     for ax in (ax_m, ax_a, ax_l):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, loc="upper left" if ax is ax_l else "best")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
+    reports.save(fig, path)
 
 
 # ------------------------------------------------------------ the report

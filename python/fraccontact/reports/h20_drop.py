@@ -8,14 +8,13 @@ Regenerate: scripts/run   (fraccontact run --help)
 import csv
 import sys
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from fmpy import simulate_fmu  # noqa: E402
-from fmpy.fmi1 import FMICallException  # noqa: E402
+from fmpy import simulate_fmu
+from fmpy.fmi1 import FMICallException
 
-from .. import atomic, fmu, model, reports  # noqa: E402
-from ..options import positive  # noqa: E402
+from .. import atomic, fmu, model, reports
+from ..options import positive
+
+plt = reports.pyplot()
 
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
@@ -90,8 +89,7 @@ def plot(path, results, figures):
     k = f"{h20['k']:.4g}".replace("e+0", "e")
     fig.suptitle(f"h20 drop test: m = {h20['m']:g} kg, v0 = {h20['v']:.3g} m/s, k = {k} N/m^1.5, "
                  f"c = {h20['c']:g} N s/m")
-    fig.tight_layout()
-    atomic.save_figure(fig, path, dpi=110, metadata={"Software": None})
+    reports.save(fig, path, dpi=110)
 
 
 def check(parser, args):
