@@ -61,11 +61,14 @@ in the CSV). Writes to --out:
   sweep.png       the results against the first varied name (a grid of
                   at most 100 000 impacts), or their histograms (Monte
                   Carlo);
-  sweep.json      counts and throughput; for Monte Carlo also the mean,
-                  sample standard deviation and 5/50/95 % percentiles
-                  (exact, numpy's linear interpolation) of every numeric
-                  column over the impacts that succeeded, which are
-                  printed too, all computed on the workers.
+  sweep.json      counts and times: impacts, failed, tasks, wall_seconds
+                  and impacts_per_second (see below), task_seconds and
+                  task_cpu_seconds (the time inside the tasks, and their
+                  CPU, summed), statistics_seconds; for Monte Carlo also
+                  the mean, sample standard deviation and 5/50/95 %
+                  percentiles (exact: numpy's linear interpolation) of
+                  every numeric column over the impacts that succeeded,
+                  computed on the workers, and printed too.
 The workers write into a hidden folder under --out, moved into place when
 the sweep ends: a failed or interrupted sweep leaves nothing.
 

@@ -15,7 +15,7 @@ from .. import model
 # (the campaign's seed, the parameter, the block's number): a task draws the
 # blocks its range touches, so that case i's values never depend on where
 # the tasks begin and end.
-BLOCK = 1 << 14
+BLOCK = 1 << 12
 # Doubles hold every integer below 2^53 exactly: below it, a grid's
 # numerators and its scale divide in floating point, correctly rounded.
 EXACT = 1 << 53
@@ -133,8 +133,8 @@ def task_size(n, batch):
 # Parquet file): TASK_MIN keeps that small against the cheapest impacts;
 # TASK_MAX bounds a worker's memory (its arrays take some hundreds of bytes
 # an impact) and TASKS leaves work to balance over many workers.
-TASKS = 64
-TASK_MIN = 5000
+TASKS = 32
+TASK_MIN = 20_000
 TASK_MAX = 200_000
 
 

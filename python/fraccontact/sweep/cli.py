@@ -41,10 +41,11 @@ def connect(args):
 
 def fold(client, calls, combine, window, done=None):
     """Runs calls ((weight, function, *args) each) on the cluster, at most
-    window at once, and folds their results with combine, FAN_IN at a time,
-    on the workers; returns the future of the whole fold. done(weight) is
-    told of each call finished. A call that failed (after Dask's retries,
-    where its worker died) raises here."""
+    window() of them at once (asked again as each ends: workers may come
+    and go), and folds their results with combine, FAN_IN at a time, on the
+    workers; returns the future of the whole fold. done(weight) is told of
+    each call finished. A call that failed (after Dask's retries, where its
+    worker died) raises here."""
     from dask.distributed import as_completed
     calls = iter(calls)
     running = as_completed()
@@ -55,13 +56,14 @@ def fold(client, calls, combine, window, done=None):
         weights[future.key] = weight
         running.add(future)
 
-    def next_call():
-        call = next(calls, None)
-        if call is not None:
+    def fill():
+        while sum(w is not None for w in weights.values()) < window():
+            call = next(calls, None)
+            if call is None:
+                return
             submit(*call[1:], weight=call[0])
 
-    for _ in range(window):
-        next_call()
+    fill()
     finished = []
     for future in running:
         if future.status == "error":
@@ -70,7 +72,7 @@ def fold(client, calls, combine, window, done=None):
         if weight is not None:
             if done:
                 done(weight)
-            next_call()
+            fill()
         finished.append(future)
         if len(finished) >= FAN_IN or (running.count() == 0 and len(finished) > 1):
             submit(combine, *finished)
@@ -78,8 +80,10 @@ def fold(client, calls, combine, window, done=None):
     return finished[0]
 
 
-def threads(client):
-    return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
+def window(client):
+    """Tasks given to the cluster at once: WINDOW for each of its threads
+    now, and one while it has none (it waits for its workers)."""
+    return lambda: WINDOW * max(1, sum(client.nthreads().values()))
 
 
 def unseen(client, folder):
@@ -103,7 +107,7 @@ def simulate(args, client, plan, size, folder):
     calls = ((stop - start, tasks.run, plan, i, start, stop, folder, args.csv) for i, start, stop in cases.ranges(n, size))
     with tqdm(total=n, unit=" impacts", unit_scale=True, file=sys.stderr, disable=None, smoothing=0.1) as bar:
         start = time.perf_counter()
-        summary = fold(client, calls, tasks.merged, WINDOW * threads(client), bar.update).result()
+        summary = fold(client, calls, tasks.merged, window(client), bar.update).result()
         return summary, time.perf_counter() - start
 
 
@@ -112,7 +116,7 @@ def run_pass(client, plan, folder, count):
     folded on the workers, finished there."""
     def over_partitions(requests):
         calls = ((0, stats.partition_pass, plan.path(folder, i, "parquet"), requests) for i in range(count))
-        folded = fold(client, calls, stats.combined, WINDOW * threads(client))
+        folded = fold(client, calls, stats.combined, window(client))
         return client.submit(stats.finished, folded, requests, pure=False).result()
     return over_partitions
 
@@ -142,7 +146,8 @@ def run(args, client, plan, size, prog):
         result = dict(impacts=summary["impacts"], failed=summary["failed"], wall_seconds=wall,
                       impacts_per_second=summary["impacts"] / wall,
                       workers=None if args.scheduler else args.workers or options.WORKERS, tasks=count,
-                      task_seconds=summary["seconds"], statistics_seconds=statistics_seconds)
+                      task_seconds=summary["seconds"], task_cpu_seconds=summary["cpu_seconds"],
+                      statistics_seconds=statistics_seconds)
         atomic.write_text(args.out / "sweep.json", json.dumps(dict(result, statistics=statistics) if statistics
                                                                else result) + "\n")
         staging.commit(written | {"sweep.json"})

@@ -367,5 +367,6 @@ def prepared(args):
     refuse_oversized(what_is_run(given["--vary"], plan_cases), plan_cases.n, len(schema) - 1, args.csv, args.out)
     fixed = {name: cases.code(name, v) for name, v in args.fixed.items()}
     size = cases.task_size(plan_cases.n, args.batch)
-    plan = tasks.Plan(plan_cases, fixed, schema, max(6, len(str((plan_cases.n - 1) // size))))
+    plan = tasks.Plan(plan_cases, fixed, schema, max(6, len(str((plan_cases.n - 1) // size))),
+                      isinstance(plan_cases, cases.MonteCarlo))
     return plan, size, unused_values(args.fixed, plan_cases)

@@ -8,10 +8,11 @@ exists (an impact that did not end by t_end has no eps):
 - the 5, 50 and 95 % percentiles exact, as numpy's linear interpolation
   gives them over all the values: the order statistics they need are found
   by passes over the partitions, each counting the values in 2^BITS bins of
-  the range still open (the bins taken on the doubles' order-preserving
-  64-bit keys, so that a pass narrows any range, however many decades it
-  spans, by 2^BITS), until the bin holding the rank has at most GATHER
-  values, which are then gathered and the rank selected among them;
+  the range still open, with each bin's smallest and largest (the bins
+  taken on the doubles' order-preserving 64-bit keys, so that a pass
+  narrows any range, however many decades it spans, by 2^BITS at least),
+  until the bin holding the rank holds one value, or at most GATHER, which
+  are then gathered and the rank selected among them;
 - the histograms of the plotted results, on the first of those passes.
 
 The client holds only the counts of the bins and the values selected."""
@@ -23,6 +24,7 @@ QUANTILES = (0.05, 0.5, 0.95)
 BITS = 12
 GATHER = 1 << 16
 SIGN = np.uint64(1 << 63)
+NO_KEY = np.uint64((1 << 64) - 1)
 # A pass narrows a range of 2^64 keys by 2^BITS: 6 passes reach one key.
 PASSES = -(-64 // BITS) + 1
 
@@ -42,16 +44,27 @@ def succeeded(table):
     return table.column("error").is_null().to_numpy(zero_copy_only=False)
 
 
-def moments(table):
-    """{column: (count, mean, sum of squared deviations, min, max)} of a
-    partition's numeric columns, where it has values."""
-    ok = succeeded(table)
+def moments(columns, failed):
+    """{column: (count, mean, sum of squared deviations, min, max)} of the
+    numeric columns ({name: array}) over the cases not failed (indices),
+    where they have values."""
+    ok = np.ones(len(next(iter(columns.values()))), dtype=bool)
+    ok[failed] = False
     out = {}
-    for name in numeric(table):
-        x = values(table, name, ok)
+    for name, x in columns.items():
+        if x.dtype.kind not in "fi":
+            continue
+        x = x.astype(np.float64, copy=False)
+        if len(failed):
+            x = x[ok]
+        finite = np.isfinite(x)
+        if not finite.all():
+            x = x[finite]
         if len(x):
             mean = x.mean()
-            out[name] = (len(x), mean, float(((x - mean) ** 2).sum()), float(x.min()), float(x.max()))
+            deviations = x - mean
+            out[name] = (len(x), mean, float(np.square(deviations, out=deviations).sum()), float(x.min()),
+                         float(x.max()))
     return out
 
 
@@ -103,9 +116,9 @@ def shift(low, high):
 
 def partition_pass(path, requests):
     """One partition's part of a pass: for each request ("bins", column,
-    low, high) the counts of its keys in [low, high] by bin, ("gather",
-    column, low, high, picks) those keys, ("hist", column, low, high, bins)
-    numpy's histogram of its values."""
+    low, high) the count, the smallest and the largest of its keys in [low,
+    high] by bin, ("gather", column, low, high, picks) those keys, ("hist",
+    column, low, high, bins) numpy's histogram of its values."""
     table = pq.read_table(path, columns=sorted({r[1] for r in requests}) + ["error"])
     ok = succeeded(table)
     columns = {}
@@ -122,14 +135,32 @@ def partition_pass(path, requests):
         if kind == "gather":
             out.append(inside)
         else:
-            bins = (inside - np.uint64(low)) >> np.uint64(shift(low, high))
-            out.append(np.bincount(bins.astype(np.int64), minlength=((high - low) >> shift(low, high)) + 1))
+            out.append(binned(inside, low, high))
     return out
 
 
+def binned(k, low, high):
+    """(count, smallest, largest) of the keys k by bin of [low, high]; an
+    empty bin's smallest is the largest key and its largest 0."""
+    bins = ((k - np.uint64(low)) >> np.uint64(shift(low, high))).astype(np.int64)
+    size = ((high - low) >> shift(low, high)) + 1
+    smallest, largest = np.full(size, NO_KEY, dtype=np.uint64), np.zeros(size, dtype=np.uint64)
+    np.minimum.at(smallest, bins, k)
+    np.maximum.at(largest, bins, k)
+    return np.bincount(bins, minlength=size), smallest, largest
+
+
 def combined(*parts):
-    """Passes over several partitions as one: counts added, keys joined."""
-    return [np.concatenate(xs) if xs[0].dtype == np.uint64 else np.sum(xs, axis=0) for xs in zip(*parts)]
+    """Passes over several partitions as one: counts added, keys joined,
+    the smallest and largest of each bin kept."""
+    return [joined(xs) for xs in zip(*parts)]
+
+
+def joined(xs):
+    if isinstance(xs[0], tuple):
+        counts, smallest, largest = zip(*xs)
+        return np.sum(counts, axis=0), np.minimum.reduce(smallest), np.maximum.reduce(largest)
+    return np.concatenate(xs) if xs[0].dtype == np.uint64 else np.sum(xs, axis=0)
 
 
 def finished(result, requests):
@@ -190,19 +221,17 @@ def request_pass(open_):
 
 def settle(wanted, found, requests, picks, results):
     """Each target after a pass: its value where gathered, else its range
-    narrowed to the bin holding its rank."""
+    narrowed to the keys in the bin holding its rank (one key: found)."""
     for target, (i, pick) in picks.items():
-        kind, _, low, high = requests[i][:4]
-        if kind == "gather":
+        if requests[i][0] == "gather":
             found[target] = double(results[i][pick])
             continue
-        low, high, below, _ = wanted[target]
-        cumulative = np.cumsum(results[i])
+        counts, smallest, largest = results[i]
+        below = wanted[target][2]
+        cumulative = np.cumsum(counts)
         b = int(np.searchsorted(cumulative, target[1] - below, side="right"))
-        s = shift(low, high)
-        before = int(cumulative[b - 1]) if b else 0
-        wanted[target] = [low + (b << s), min(high, low + ((b + 1) << s) - 1), below + before,
-                          int(results[i][b])]
+        wanted[target] = [int(smallest[b]), int(largest[b]), below + (int(cumulative[b - 1]) if b else 0),
+                          int(counts[b])]
 
 
 def statistics_of(name, m, found):

@@ -4,6 +4,7 @@ inputs beside results, as a Parquet partition (and a CSV part when asked),
 and returns a small summary: counts, the first refusals, the moments of
 every numeric column. Nothing of the cases goes back to the client."""
 
+import ctypes
 import time
 import warnings
 from dataclasses import dataclass
@@ -13,7 +14,7 @@ import pyarrow as pa
 import pyarrow.csv
 import pyarrow.parquet as pq
 
-from .. import atomic, model
+from .. import _lib, atomic, model
 from . import stats
 
 # The results of a run, as fraccontact.impacts returns them: the first
@@ -32,6 +33,7 @@ class Plan:
     fixed: dict
     schema: pa.Schema
     width: int  # digits of a partition's number: the files sort in case order
+    statistics: bool  # whether the tasks return their columns' moments (Monte Carlo)
 
     def path(self, folder, index, suffix):
         return folder / f"part-{index:0{self.width}d}.{suffix}"
@@ -51,60 +53,105 @@ def schema(inputs):
 def run(plan, index, start, stop, folder, csv):
     """Task `index`: cases start to stop - 1, written under folder; returns
     its summary."""
-    began = time.perf_counter()
+    began, cpu = time.perf_counter(), time.thread_time()
     shown, given = plan.cases.inputs(start, stop)
-    with warnings.catch_warnings():  # the client has warned once already
-        warnings.simplefilter("ignore")
-        results, errors = library_results(plan.fixed, given, stop - start)
-    table = pa.Table.from_arrays([*shown.values(), *results.values(), pa.array(errors, pa.string())],
+    results, errors = library_results(plan.fixed, given, stop - start)
+    table = pa.Table.from_arrays([*shown.values(), *results.values(), messages(errors, stop - start)],
                                  schema=plan.schema)
     write(table, plan, folder, index, csv)
-    failed = [i for i, why in enumerate(errors) if why is not None]
-    return dict(impacts=stop - start, failed=len(failed), seconds=time.perf_counter() - began, tasks=1,
+    failed = sorted(errors)
+    columns = dict(zip(plan.schema.names, [*shown.values(), *results.values()]))
+    moments = stats.moments(columns, failed) if plan.statistics else {}
+    return dict(impacts=stop - start, failed=len(failed), seconds=time.perf_counter() - began,
+                cpu_seconds=time.thread_time() - cpu, tasks=1,
                 errors=[(start + i, {name: column[i].item() for name, column in shown.items()}, errors[i])
-                        for i in failed[:ERRORS_KEPT]],
-                moments=stats.moments(table))
+                        for i in failed[:ERRORS_KEPT]], moments=moments)
 
 
 def merged(*summaries):
-    """The summary of several tasks: counts and seconds added, the first
+    """The summary of several tasks: counts and times added, the first
     refusals kept, the moments merged."""
     moments = {}
     for s in summaries:
         moments = stats.merged_moments(moments, s["moments"])
-    return dict({key: sum(s[key] for s in summaries) for key in ("impacts", "failed", "seconds", "tasks")},
+    return dict({key: sum(s[key] for s in summaries) for key in ("impacts", "failed", "seconds", "cpu_seconds", "tasks")},
                 errors=sorted((e for s in summaries for e in s["errors"]), key=lambda e: e[0])[:ERRORS_KEPT], moments=moments)
+
+
+PARAMS, OUTCOME = np.dtype(_lib.Params), np.dtype(_lib.Outcome)
+
+
+def record(fixed, given):
+    """The parameters every case of a batch shares: the library's defaults
+    and the fixed values (a draw replaces its nominal value)."""
+    p = _lib.Params()
+    _lib.LIB.fc_params_default(ctypes.byref(p))
+    shared = np.frombuffer(bytes(p), dtype=PARAMS).copy()
+    for name, x in fixed.items():
+        if name not in given:
+            shared["v" if name == "height" else name] = velocities(x) if name == "height" else x
+    return shared
+
+
+def velocities(height):
+    """v of each drop height (fraccontact.drop_velocity, once a distinct
+    height); NaN for a height the library cannot drop from, so that its
+    case is refused."""
+    heights, where = np.unique(np.atleast_1d(np.asarray(height, dtype=np.float64)), return_inverse=True)
+    v = np.array([model.drop_velocity(h) if np.isfinite(h) and h >= 0 else np.nan for h in heights])
+    return v[where.reshape(np.shape(height))]
 
 
 def library_results(fixed, given, n):
     """The RESULTS of the cases whose parameters are the arrays in given
-    (fixed holds the rest; a draw replaces its nominal value) in one library
-    call, and a list of each case's refusal (None where it ran). A batch the
-    library refuses runs its cases one by one, to tell which."""
-    fixed = {name: v for name, v in fixed.items() if name not in given}
-    try:
-        out = model.impacts(**fixed, **given)
-        return {key: np.asarray(out[key]) for key in RESULTS}, [None] * n
-    except (ValueError, RuntimeError):
-        pass
-    results = {key: np.zeros(n, dtype=np.int64) if key in COUNTS else np.full(n, np.nan) for key in RESULTS}
-    errors = [None] * n
-    for i in range(n):
-        try:
-            out = model.impacts(**fixed, **{name: a[i] for name, a in given.items()})
-        except (ValueError, RuntimeError) as e:
-            errors[i] = str(e)
-            continue
-        for key in RESULTS:
-            results[key][i] = out[key]
+    (fixed holds the rest; a draw replaces its nominal value), in one call
+    of the library's fc_run_batch, and {index: the library's message} of
+    the cases it refused (their results NaN, or 0 for the counts). The library is
+    called directly: fraccontact.impacts builds Python objects for each
+    case beside its arrays (the stop's word, its checks), which cost a
+    tenth of an error-controlled impact; the refusal's message is still
+    its own, from fraccontact.impacts on that case alone."""
+    batch = np.tile(record(fixed, given), n)
+    for name, x in given.items():
+        batch["v" if name == "height" else name] = velocities(x) if name == "height" else x
+    out = np.zeros(n, dtype=OUTCOME)
+    _lib.LIB.fc_run_batch(n, batch.ctypes.data, out.ctypes.data)
+    ended = out["impacts"] > 0
+    results = {name: np.where(ended, out["first"][name], np.nan) for name in model.IMPACT_FIGURES}
+    results.update(impacts=out["impacts"], steps=out["steps"], k=out["k"])
+    refused = np.flatnonzero(out["status"] != _lib.FC_OK)
+    results["k"][refused] = np.nan
+    errors = {int(i): refusal({**fixed, **{name: x[i] for name, x in given.items()}}, out["status"][i])
+              for i in refused}
     return results, errors
+
+
+def messages(errors, n):
+    """The error column: each refusal's message, null for the cases that ran."""
+    if not errors:
+        return pa.nulls(n, pa.string())
+    column = np.full(n, None, dtype=object)
+    column[list(errors)] = list(errors.values())
+    return pa.array(column, pa.string())
+
+
+def refusal(case, status):
+    """The library's message for a case it refused, as fraccontact.impacts
+    gives it."""
+    with warnings.catch_warnings():  # the client has warned once already
+        warnings.simplefilter("ignore")
+        try:
+            model.impacts(**case)
+        except (ValueError, RuntimeError) as e:
+            return str(e)
+    return f"the run failed (status {status})"
 
 
 def write(table, plan, folder, index, csv):
     """The partition, each file whole or not at all (a task run again after
     its worker died writes the same bytes over it)."""
     with atomic.replacing(plan.path(folder, index, "parquet"), "wb") as f:
-        pq.write_table(table, f)
+        pq.write_table(table, f, use_dictionary=False)  # trying dictionaries on doubles costs most of a write
     if csv:
         with atomic.replacing(plan.path(folder, index, "csv"), "wb") as f:
             pyarrow.csv.write_csv(table, f)
