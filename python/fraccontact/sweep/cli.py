@@ -132,6 +132,7 @@ def run(args, client, plan, size, prog):
             staging.discard()
             return 2
         client.run(importlib.import_module, tasks.__name__)  # every worker loads the library before the clock
+        outputs.preload()
         summary, wall = simulate(args, client, plan, size, staging.folder)
         count = len(range(0, plan.cases.n, size))
         monte_carlo = args.monte_carlo is not None

@@ -9,6 +9,7 @@ import os
 import pathlib
 import shutil
 import tempfile
+import threading
 
 import numpy as np
 import pyarrow as pa
@@ -88,11 +89,21 @@ def shown(v):
     return f"{v:g}" if isinstance(v, float) else str(v)
 
 
-def figure(columns):
+def pyplot():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    return plt.subplots(*columns)
+    return plt
+
+
+def preload():
+    """Imports matplotlib in the background while the client waits for its
+    tasks: the plot comes after them."""
+    threading.Thread(target=pyplot, daemon=True).start()
+
+
+def figure(columns):
+    return pyplot().subplots(*columns)
 
 
 def plot(path, files, names, title):
