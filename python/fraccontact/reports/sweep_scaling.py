@@ -198,6 +198,8 @@ def lines(runs, load, head, minutes):
     large_two = serial(runs["large_two"])
     rss_small, rss_large = runs["small_two"]["rss"], runs["large_two"]["rss"]
     cpu_one = median(r["client_cpu"] + r["workers_cpu"] for r in runs["one"])
+    library_cpu = median(r["summary"]["library_cpu_seconds"] for r in runs["one"]) / IMPACTS
+    task_cpu = median(r["summary"]["task_cpu_seconds"] for r in runs["one"]) / IMPACTS
     amdahl = 1 / (fraction + (1 - fraction) / 16)
     return [
         "# The sweep at scale", "",
@@ -240,8 +242,10 @@ def lines(runs, load, head, minutes):
         f"their inputs and Parquet files), {parts['statistics']:.2f} s of statistics (Dask tasks over the "
         f"partitions), {parts['writing']:.2f} s writing the plot and sweep.json. With a serial fraction s, "
         f"Amdahl's law allows 1 / (s + (1 - s) / 16) = {amdahl:.1f}x on 16 workers at this size. The C core's "
-        f"CPU per impact: {1e6 / core_cpu_rate:.2f} µs; the whole one-worker command's CPU (client and worker "
-        f"processes): {1e6 * cpu_one / IMPACTS:.2f} µs an impact.", "",
+        f"CPU per impact: {1e6 / core_cpu_rate:.2f} µs; in the worker's tasks, the library calls' "
+        f"{1e6 * library_cpu:.2f} µs and the whole tasks' {1e6 * task_cpu:.2f} µs (the inputs, the batch, the "
+        f"Parquet file, the moments: {100 * (task_cpu / library_cpu - 1):.1f} % more); the whole one-worker "
+        f"command's CPU (client and worker processes): {1e6 * cpu_one / IMPACTS:.2f} µs an impact.", "",
         "Bit for bit: the Parquet partitions ({} files) of the one-worker run are the same bytes as those of "
         "{}.".format(runs["partitions"], ", ".join(f"{name} ({'identical' if same else '**different**'})"
                                                      for name, same in runs["identical"].items()))

@@ -62,9 +62,11 @@ in the CSV). Writes to --out:
                   at most 100 000 impacts), or their histograms (Monte
                   Carlo);
   sweep.json      counts and times: impacts, failed, tasks, wall_seconds
-                  and impacts_per_second (see below), task_seconds and
-                  task_cpu_seconds (the time inside the tasks, and their
-                  CPU, summed), statistics_seconds; for Monte Carlo also
+                  and impacts_per_second (see below), task_seconds,
+                  task_cpu_seconds and library_cpu_seconds (the time
+                  inside the tasks, their CPU, and the CPU of their
+                  library calls, summed), statistics_seconds; for Monte
+                  Carlo also
                   the mean, sample standard deviation and 5/50/95 %
                   percentiles (exact: numpy's linear interpolation) of
                   every numeric column over the impacts that succeeded,

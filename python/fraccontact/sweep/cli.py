@@ -148,6 +148,7 @@ def run(args, client, plan, size, prog):
                       impacts_per_second=summary["impacts"] / wall,
                       workers=None if args.scheduler else args.workers or options.WORKERS, tasks=count,
                       task_seconds=summary["seconds"], task_cpu_seconds=summary["cpu_seconds"],
+                      library_cpu_seconds=summary["library_cpu_seconds"],
                       statistics_seconds=statistics_seconds)
         atomic.write_text(args.out / "sweep.json", json.dumps(dict(result, statistics=statistics) if statistics
                                                                else result) + "\n")

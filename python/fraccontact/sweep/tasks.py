@@ -55,7 +55,7 @@ def run(plan, index, start, stop, folder, csv):
     its summary."""
     began, cpu = time.perf_counter(), time.thread_time()
     shown, given = plan.cases.inputs(start, stop)
-    results, errors = library_results(plan.fixed, given, stop - start)
+    results, errors, library_cpu = library_results(plan.fixed, given, stop - start)
     table = pa.Table.from_arrays([*shown.values(), *results.values(), messages(errors, stop - start)],
                                  schema=plan.schema)
     write(table, plan, folder, index, csv)
@@ -63,7 +63,7 @@ def run(plan, index, start, stop, folder, csv):
     columns = dict(zip(plan.schema.names, [*shown.values(), *results.values()]))
     moments = stats.moments(columns, failed) if plan.statistics else {}
     return dict(impacts=stop - start, failed=len(failed), seconds=time.perf_counter() - began,
-                cpu_seconds=time.thread_time() - cpu, tasks=1,
+                cpu_seconds=time.thread_time() - cpu, library_cpu_seconds=library_cpu, tasks=1,
                 errors=[(start + i, {name: column[i].item() for name, column in shown.items()}, errors[i])
                         for i in failed[:ERRORS_KEPT]], moments=moments)
 
@@ -74,7 +74,7 @@ def merged(*summaries):
     moments = {}
     for s in summaries:
         moments = stats.merged_moments(moments, s["moments"])
-    return dict({key: sum(s[key] for s in summaries) for key in ("impacts", "failed", "seconds", "cpu_seconds", "tasks")},
+    return dict({key: sum(s[key] for s in summaries) for key in ("impacts", "failed", "seconds", "cpu_seconds", "library_cpu_seconds", "tasks")},
                 errors=sorted((e for s in summaries for e in s["errors"]), key=lambda e: e[0])[:ERRORS_KEPT], moments=moments)
 
 
@@ -106,7 +106,8 @@ def library_results(fixed, given, n):
     """The RESULTS of the cases whose parameters are the arrays in given
     (fixed holds the rest; a draw replaces its nominal value), in one call
     of the library's fc_run_batch, and {index: the library's message} of
-    the cases it refused (their results NaN, or 0 for the counts). The library is
+    the cases it refused (their results NaN, or 0 for the counts), and the
+    CPU seconds of the library call. The library is
     called directly: fraccontact.impacts builds Python objects for each
     case beside its arrays (the stop's word, its checks), which cost a
     tenth of an error-controlled impact; the refusal's message is still
@@ -115,7 +116,9 @@ def library_results(fixed, given, n):
     for name, x in given.items():
         batch["v" if name == "height" else name] = velocities(x) if name == "height" else x
     out = np.zeros(n, dtype=OUTCOME)
+    cpu = time.thread_time()
     _lib.LIB.fc_run_batch(n, batch.ctypes.data, out.ctypes.data)
+    cpu = time.thread_time() - cpu
     ended = out["impacts"] > 0
     results = {name: np.where(ended, out["first"][name], np.nan) for name in model.IMPACT_FIGURES}
     results.update(impacts=out["impacts"], steps=out["steps"], k=out["k"])
@@ -123,7 +126,7 @@ def library_results(fixed, given, n):
     results["k"][refused] = np.nan
     errors = {int(i): refusal({**fixed, **{name: x[i] for name, x in given.items()}}, out["status"][i])
               for i in refused}
-    return results, errors
+    return results, errors, cpu
 
 
 def messages(errors, n):
