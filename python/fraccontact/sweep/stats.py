@@ -57,9 +57,8 @@ def moments(columns, failed):
         x = x.astype(np.float64, copy=False)
         if len(failed):
             x = x[ok]
-        finite = np.isfinite(x)
-        if not finite.all():
-            x = x[finite]
+        if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
+            x = x[np.isfinite(x)]
         if len(x):
             mean = x.mean()
             deviations = x - mean

@@ -154,7 +154,8 @@ def write(table, plan, folder, index, csv):
     """The partition, each file whole or not at all (a task run again after
     its worker died writes the same bytes over it)."""
     with atomic.replacing(plan.path(folder, index, "parquet"), "wb") as f:
-        pq.write_table(table, f, use_dictionary=False)  # trying dictionaries on doubles costs most of a write
+        # Random doubles neither compress nor fit a dictionary: trying costs most of a write.
+        pq.write_table(table, f, use_dictionary=False, compression="none")
     if csv:
         with atomic.replacing(plan.path(folder, index, "csv"), "wb") as f:
             pyarrow.csv.write_csv(table, f)
