@@ -1,4 +1,4 @@
-"""fraccontact sweep (fraccontact/sweep.py) on a local Dask cluster with a
+"""fraccontact sweep (fraccontact/sweep/) on a local Dask cluster with a
 small grid: every impact is the library's own result, in case order; any
 parameter of the library can be varied or set, by its name with dashes or
 underscores; a case the library refuses is a row with its message; a Monte
