@@ -23,7 +23,7 @@ import pytest
 
 import fraccontact
 from fraccontact import sweep
-from fraccontact.sweep import cases, options, stats, tasks
+from fraccontact.sweep import cases, options, outputs, stats, tasks
 
 pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
                                 reason="Dask workers under a preloaded sanitizer runtime")
@@ -146,6 +146,42 @@ def test_statistics_are_numpys_on_hard_values(gather, tmp_path, monkeypatch):
             assert s["std"] is None and name == "s"
     narrowed = [any(r[0] == "bins" for r in requests) for requests in passes]
     assert narrowed[0] == (gather < 5000)
+
+
+# ---------------------------------------------------------------- outputs, in process
+
+
+def test_outputs_replace_an_older_run_whole(tmp_path):
+    """The partitions move into place as one folder; an older run's files
+    that this run does not write are removed; a half-written leftover of a
+    dead worker is dropped; nothing hidden is left."""
+    out = tmp_path / "out"
+    (out / "sweep.parquet").mkdir(parents=True)
+    for name in ("sweep.parquet/part-000000.parquet", "sweep.parquet/part-000001.parquet", "sweep.csv",
+                 "sweep.png", "sweep.json"):
+        (out / name).write_text("old")
+    staging = outputs.Staging(out)
+    (staging.folder / "part-000000.parquet").write_text("new")
+    (staging.folder / ".part-000001.parquet.x.tmp").write_text("half")
+    (out / "sweep.json").write_text("new")
+    staging.commit({"sweep.json"})
+    assert sorted(p.name for p in out.iterdir()) == ["sweep.json", "sweep.parquet"]
+    assert [(p.name, p.read_text()) for p in (out / "sweep.parquet").iterdir()] == [("part-000000.parquet", "new")]
+
+
+def test_a_failed_sweep_leaves_nothing(tmp_path):
+    """discard(): the hidden folder goes, and so do the folders the sweep
+    made for --out; an existing --out keeps what it held."""
+    out = tmp_path / "a" / "b"
+    staging = outputs.Staging(out)
+    (staging.folder / "part-000000.parquet").write_text("partial")
+    staging.discard()
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()
+    (tmp_path / "kept" / "mine.txt").write_text("x")
+    staging = outputs.Staging(tmp_path / "kept")
+    staging.discard()
+    assert [p.name for p in (tmp_path / "kept").iterdir()] == ["mine.txt"]
 
 
 # ---------------------------------------------------------------- clusters
