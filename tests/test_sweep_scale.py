@@ -163,10 +163,11 @@ def test_outputs_replace_an_older_run_whole(tmp_path):
     staging = outputs.Staging(out)
     (staging.folder / "part-000000.parquet").write_text("new")
     (staging.folder / ".part-000001.parquet.x.tmp").write_text("half")
-    (out / "sweep.json").write_text("new")
+    (staging.folder / "sweep.json").write_text("new")
     staging.commit({"sweep.json"})
     assert sorted(p.name for p in out.iterdir()) == ["sweep.json", "sweep.parquet"]
     assert [(p.name, p.read_text()) for p in (out / "sweep.parquet").iterdir()] == [("part-000000.parquet", "new")]
+    assert (out / "sweep.json").read_text() == "new"
 
 
 def test_a_failed_sweep_leaves_nothing(tmp_path):

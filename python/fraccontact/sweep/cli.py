@@ -101,8 +101,8 @@ def title_of(args, n):
 
 def simulate(args, client, plan, size, folder):
     """Every task, a window at a time, with Dask's results folded; returns
-    the folded summary, the number of tasks and the wall time from the
-    first task given to the last summary folded."""
+    the folded summary and the wall time from the first task given to the
+    last summary folded."""
     n = plan.cases.n
     calls = ((stop - start, tasks.run, plan, i, start, stop, folder, args.csv) for i, start, stop in cases.ranges(n, size))
     with tqdm(total=n, unit=" impacts", unit_scale=True, file=sys.stderr, disable=None, smoothing=0.1) as bar:
@@ -150,8 +150,8 @@ def run(args, client, plan, size, prog):
                       task_seconds=summary["seconds"], task_cpu_seconds=summary["cpu_seconds"],
                       library_cpu_seconds=summary["library_cpu_seconds"],
                       statistics_seconds=statistics_seconds)
-        atomic.write_text(args.out / "sweep.json", json.dumps(dict(result, statistics=statistics) if statistics
-                                                               else result) + "\n")
+        atomic.write_text(staging.folder / "sweep.json",
+                          json.dumps(dict(result, statistics=statistics) if statistics else result) + "\n")
         staging.commit(written | {"sweep.json"})
     except BaseException:
         staging.discard()
@@ -170,14 +170,14 @@ def write(args, plan, staging, count, summary, statistics, counted):
     of at most PLOT_LIMIT cases); the names written."""
     written = set()
     if args.csv:
-        outputs.join_csv((plan.path(staging.folder, i, "csv") for i in range(count)), args.out / "sweep.csv")
+        outputs.join_csv((plan.path(staging.folder, i, "csv") for i in range(count)), staging.folder / "sweep.csv")
         written.add("sweep.csv")
     title = title_of(args, summary["impacts"])
     if counted:
-        outputs.histograms(args.out / "sweep.png", counted, statistics, title)
+        outputs.histograms(staging.folder / "sweep.png", counted, statistics, title)
         written.add("sweep.png")
     elif args.monte_carlo is None and plan.cases.n <= outputs.PLOT_LIMIT:
-        outputs.plot(args.out / "sweep.png", [plan.path(staging.folder, i, "parquet") for i in range(count)],
+        outputs.plot(staging.folder / "sweep.png", [plan.path(staging.folder, i, "parquet") for i in range(count)],
                      [name for name, _ in args.vary], title)
         written.add("sweep.png")
     return written

@@ -1,8 +1,9 @@
 """What a sweep leaves in --out: the workers' partitions, gathered in a
-hidden folder while the sweep runs and moved into place as sweep.parquet/
-at its end (a failed or interrupted sweep leaves nothing); sweep.csv
-joined from the workers' CSV parts when asked; the plots; sweep.json. An
-older run's outputs are replaced, or removed where this run writes none."""
+hidden folder while the sweep runs, with sweep.csv (joined from the
+workers' CSV parts, when asked), the plot and sweep.json beside them, all
+moved into place at its end (a failed or interrupted sweep leaves
+nothing). An older run's outputs are replaced, or removed where this run
+writes none."""
 
 import math
 import os
@@ -46,9 +47,14 @@ class Staging:
                 break
 
     def commit(self, written):
-        """Moves the partitions into place (leftovers of tasks that a dead
-        worker left half-written dropped) and removes the older run's files
-        this one did not write."""
+        """Moves the files written (names) and the partitions into place,
+        leftovers of tasks that a dead worker left half-written dropped, and
+        removes the older run's files this one did not write."""
+        for name in FILES:
+            if name in written:
+                os.replace(self.folder / name, self.out / name)
+            elif (self.out / name).exists():
+                (self.out / name).unlink()
         for leftover in self.folder.glob(".*.tmp"):
             leftover.unlink()
         os.chmod(self.folder, 0o755)  # mkdtemp's 0700 is for the hidden folder only
@@ -60,9 +66,6 @@ class Staging:
         os.replace(self.folder, final)
         if old:
             shutil.rmtree(old)
-        for name in FILES:
-            if name not in written and (self.out / name).exists():
-                (self.out / name).unlink()
 
 
 def join_csv(parts, path):
