@@ -4,6 +4,7 @@ statistics (Monte Carlo), the CSV when asked, the plot and sweep.json."""
 
 import importlib
 import json
+import math
 import os
 import sys
 import time
@@ -25,10 +26,15 @@ def connect(args):
     """(client, cluster): a Dask client of the scheduler at --scheduler
     (cluster None), refused in one line when none answers there within
     CONNECT_TIMEOUT, or of a local cluster of --workers processes."""
+    import dask
     from dask.distributed import Client, LocalCluster
     if not args.scheduler:
-        cluster = LocalCluster(n_workers=args.workers or options.WORKERS, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+        # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which also
+        # keeps glibc from raising its mmap threshold: every array of a task
+        # would then come in fresh pages. The local workers keep glibc's own.
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            cluster = LocalCluster(n_workers=args.workers or options.WORKERS, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
         return Client(cluster), cluster
     try:
         return Client(args.scheduler, timeout=options.CONNECT_TIMEOUT), None
@@ -82,8 +88,15 @@ def fold(client, calls, combine, window, done=None):
 
 def window(client):
     """Tasks given to the cluster at once: WINDOW for each of its threads
-    now, and one while it has none (it waits for its workers)."""
-    return lambda: WINDOW * max(1, sum(client.nthreads().values()))
+    (asked of the scheduler at most once a second), and one while it has
+    none (it waits for its workers)."""
+    known = dict(at=-math.inf, size=1)
+
+    def size():
+        if time.monotonic() - known["at"] > 1:
+            known.update(at=time.monotonic(), size=WINDOW * max(1, sum(client.nthreads().values())))
+        return known["size"]
+    return size
 
 
 def unseen(client, folder):

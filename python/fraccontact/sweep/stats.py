@@ -35,13 +35,21 @@ def numeric(table):
 
 
 def values(table, name, ok):
-    """A column's finite values of the impacts that succeeded, as doubles."""
-    x = table.column(name).to_numpy()[ok].astype(np.float64, copy=False)
-    return x[np.isfinite(x)]
+    """A column's finite values of the impacts that succeeded (ok: None
+    for all), as doubles; copied only where some are left out."""
+    x = table.column(name).to_numpy()
+    if ok is not None:
+        x = x[ok]
+    x = x.astype(np.float64, copy=False)
+    if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
+        x = x[np.isfinite(x)]
+    return x
 
 
 def succeeded(table):
-    return table.column("error").is_null().to_numpy(zero_copy_only=False)
+    """Which impacts succeeded, or None for all."""
+    error = table.column("error")
+    return None if error.null_count == len(error) else error.is_null().to_numpy(zero_copy_only=False)
 
 
 def moments(columns, failed):
@@ -82,8 +90,11 @@ def merged_moments(a, b):
 
 
 def key(x):
-    """Each double's key: unsigned integers in the doubles' order."""
+    """Each double's key: unsigned integers in the doubles' order (the
+    sign bit set for the positive, every bit flipped for the negative)."""
     bits = np.ascontiguousarray(x, dtype=np.float64).view(np.uint64)
+    if len(bits) and not np.signbit(x).any():
+        return bits | SIGN
     return np.where(bits >> np.uint64(63) == 1, ~bits, bits | SIGN)
 
 
