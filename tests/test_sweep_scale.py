@@ -103,7 +103,8 @@ def hard_partitions(folder):
         x[rng.random(size) < 0.3] = 1.5  # ties at the median
         n = rng.integers(0, 4, size)
         error = np.where(rng.random(size) < 0.1, "refused", None)
-        table = tasks.pa.table({"x": x, "n": n, "one": np.full(size, 0.626418), "s": np.where(np.arange(size) == 0, 2.0, np.nan) if i == 2 else np.full(size, np.nan),
+        single = np.where(np.arange(size) == 0, 2.0, np.nan) if i == 2 else np.full(size, np.nan)
+        table = tasks.pa.table({"x": x, "n": n, "one": np.full(size, 0.626418), "s": single,
                                 "error": tasks.pa.array(error, tasks.pa.string())})
         files.append(folder / f"part-{i}.parquet")
         pq.write_table(table, files[-1])
@@ -355,3 +356,27 @@ def test_a_worker_killed_mid_run_loses_nothing(cluster, tmp_path):
     names, data = partitions(out)
     assert len(names) == 20
     assert [(tmp_path / "reference" / name).read_bytes() for name in names] == data
+
+
+# ---------------------------------------------------------------- the README's figures
+
+
+def test_the_readme_quotes_the_scaling_report():
+    """Each figure the README gives of the sweep at scale is the one
+    docs/sweep_scaling.md measured (scripts/report sweep_scaling)."""
+    import re
+    root = os.path.join(os.path.dirname(__file__), "..")
+    doc = open(os.path.join(root, "docs", "sweep_scaling.md")).read()
+    readme = " ".join(open(os.path.join(root, "README.md")).read().split())
+
+    def cell(row, column):
+        line = next(line for line in doc.splitlines() if line.startswith(f"| {row}"))
+        return line.split("|")[column].strip()
+    quoted = [cell("one worker, 10,000,000 impacts, end to end", 4), cell("one worker, 1,000,000 impacts, end to end", 4),
+              cell("serial fraction, one worker, 10,000,000", 4), cell("serial fraction, one worker, 1,000,000", 4),
+              re.search(r"the moments: ([\d.]+ %) more", doc).group(1),
+              f"{cell('client', 2)} for 10^7 impacts against {cell('client', 3)} for 10^5",
+              cell("two workers, 1,000,000 impacts, end to end", 4)]
+    assert "**different**" not in doc and doc.count("(identical)") == 3
+    for figure in quoted:
+        assert figure in readme, figure

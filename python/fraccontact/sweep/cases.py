@@ -122,20 +122,20 @@ class MonteCarlo:
         return shown, shown
 
 
+# A task costs a fixed time beside its impacts (Dask's round trip, opening
+# its Parquet file): TASK_MIN keeps that small against the cheapest impacts;
+# TASK_MAX bounds a worker's memory (its arrays grow with its impacts), and
+# TASKS leaves work to balance over several workers.
+TASKS = 32
+TASK_MIN = 20_000
+TASK_MAX = 200_000
+
+
 def task_size(n, batch):
     """Impacts per task: --batch, else a size that depends on n alone (never
     on the workers, so that the partitions are the same on any cluster):
     about TASKS tasks, each between TASK_MIN and TASK_MAX impacts."""
     return batch or min(max(math.ceil(n / TASKS), TASK_MIN), TASK_MAX)
-
-
-# A task costs some milliseconds beside its impacts (Dask's round trip, the
-# Parquet file): TASK_MIN keeps that small against the cheapest impacts;
-# TASK_MAX bounds a worker's memory (its arrays take some hundreds of bytes
-# an impact) and TASKS leaves work to balance over many workers.
-TASKS = 32
-TASK_MIN = 20_000
-TASK_MAX = 200_000
 
 
 def ranges(n, size):

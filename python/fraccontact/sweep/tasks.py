@@ -105,13 +105,13 @@ def velocities(height):
 def library_results(fixed, given, n):
     """The RESULTS of the cases whose parameters are the arrays in given
     (fixed holds the rest; a draw replaces its nominal value), in one call
-    of the library's fc_run_batch, and {index: the library's message} of
-    the cases it refused (their results NaN, or 0 for the counts), and the
-    CPU seconds of the library call. The library is
-    called directly: fraccontact.impacts builds Python objects for each
-    case beside its arrays (the stop's word, its checks), which cost a
-    tenth of an error-controlled impact; the refusal's message is still
-    its own, from fraccontact.impacts on that case alone."""
+    of the library's fc_run_batch; {index: the library's message} of the
+    cases it refused (their results NaN, or 0 for the counts); the CPU
+    seconds of the library call. The library is called directly, without
+    the Python objects fraccontact.impacts makes for each case (the stop's
+    word, its checks), which would cost time beside every impact; a
+    refused case's message is still fraccontact.impacts' own, from that
+    case alone."""
     batch = np.tile(record(fixed, given), n)
     for name, x in given.items():
         batch["v" if name == "height" else name] = velocities(x) if name == "height" else x
