@@ -117,7 +117,8 @@ def simulate(args, client, plan, size, folder):
     the folded summary and the wall time from the first task given to the
     last summary folded."""
     n = plan.cases.n
-    calls = ((stop - start, tasks.run, plan, i, start, stop, folder, args.csv) for i, start, stop in cases.ranges(n, size))
+    calls = ((stop - start, tasks.run, plan, i, start, stop, folder, args.csv)
+             for i, start, stop in cases.ranges(n, size))
     with tqdm(total=n, unit=" impacts", unit_scale=True, file=sys.stderr, disable=None, smoothing=0.1) as bar:
         start = time.perf_counter()
         summary = fold(client, calls, tasks.merged, window(client), bar.update).result()

@@ -22,6 +22,7 @@ from . import stats
 RESULTS = model.IMPACT_FIGURES + ("impacts", "steps", "k")
 COUNTS = ("impacts", "steps")
 ERRORS_KEPT = 5  # refusals a summary carries, to be printed
+ADDED = ("impacts", "failed", "seconds", "cpu_seconds", "library_cpu_seconds", "tasks")  # a summary's sums
 
 
 @dataclass(frozen=True)
@@ -74,8 +75,8 @@ def merged(*summaries):
     moments = {}
     for s in summaries:
         moments = stats.merged_moments(moments, s["moments"])
-    return dict({key: sum(s[key] for s in summaries) for key in ("impacts", "failed", "seconds", "cpu_seconds", "library_cpu_seconds", "tasks")},
-                errors=sorted((e for s in summaries for e in s["errors"]), key=lambda e: e[0])[:ERRORS_KEPT], moments=moments)
+    errors = sorted((e for s in summaries for e in s["errors"]), key=lambda e: e[0])[:ERRORS_KEPT]
+    return dict({key: sum(s[key] for s in summaries) for key in ADDED}, errors=errors, moments=moments)
 
 
 PARAMS, OUTCOME = np.dtype(_lib.Params), np.dtype(_lib.Outcome)
