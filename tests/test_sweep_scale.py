@@ -380,3 +380,28 @@ def test_the_readme_quotes_the_scaling_report():
     assert "**different**" not in doc and doc.count("(identical)") == 3
     for figure in quoted:
         assert figure in readme, figure
+
+
+def test_ctrl_c_stops_the_sweep_and_leaves_nothing(tmp_path):
+    """SIGINT while the tasks run: exit status 130 within seconds, one line
+    saying so, no traceback, and --out (which the sweep made) gone."""
+    out = tmp_path / "out"
+    sweeping = subprocess.Popen([sys.executable, "-m", "fraccontact", "sweep", "--monte-carlo", "10000000",
+                                 "--scatter", "c=10%", "--workers", "1", "--out", str(out)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 60
+        while not list(out.glob(".sweep.parquet.*")) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.5)  # the tasks under way
+        sweeping.send_signal(signal.SIGINT)
+        stopped = time.monotonic()
+        _, stderr = sweeping.communicate(timeout=30)
+    finally:
+        if sweeping.poll() is None:
+            sweeping.kill()
+            sweeping.wait()
+    assert sweeping.returncode == 130 and time.monotonic() - stopped < 10, stderr[-3000:]
+    assert "interrupted; nothing written" in stderr and "Traceback" not in stderr
+    assert not out.exists()
