@@ -276,14 +276,14 @@ class Cluster:
     as processes on the loopback address, without nannies (a worker
     killed stays dead)."""
 
-    def __init__(self, folder, workers):
+    def __init__(self, folder, workers, env=None):
         self.file = folder / "scheduler.json"
         self.processes = [start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                                 "--scheduler-file", str(self.file))]
         try:
             self.address = self.wait_for_address()
             self.workers = [start("worker", self.address, "--host", "127.0.0.1", "--nthreads", "1", "--no-nanny",
-                                  "--no-dashboard") for _ in range(workers)]
+                                  "--no-dashboard", env=env) for _ in range(workers)]
             self.processes += self.workers
             from dask.distributed import Client
             with Client(self.address, timeout=30) as client:
@@ -308,8 +308,8 @@ class Cluster:
 def cluster(tmp_path):
     made = []
 
-    def make(workers):
-        made.append(Cluster(tmp_path, workers))
+    def make(workers, env=None):
+        made.append(Cluster(tmp_path, workers, env))
         return made[-1]
     yield make
     for c in made:
@@ -321,6 +321,17 @@ def test_a_scheduler_and_a_worker_started_as_processes(cluster, local_runs, tmp_
     remote = cluster(1)
     assert sweep.main(MC + ["--scheduler", remote.address, "--out", str(tmp_path / "out")]) == 0
     assert partitions(tmp_path / "out") == partitions(local_runs[0])
+
+
+def test_workers_without_the_package_are_refused_in_one_line(cluster, tmp_path, capsys):
+    """A worker started where fraccontact is not installed (no PYTHONPATH
+    to this source tree): one line saying so, exit status 2, nothing
+    written."""
+    remote = cluster(1, env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
+    assert sweep.main(MC + ["--scheduler", remote.address, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "the workers cannot import the sweep" in err[-1] and "pip install" in err[-1], err[-3:]
+    assert not (tmp_path / "out").exists()
 
 
 DEATH = ["--monte-carlo", "1000", "--scatter", "c=10%", "--batch", "50", "--seed", "9"]  # 20 tasks of some 40 ms

@@ -145,7 +145,13 @@ def run(args, client, plan, size, prog):
                   "needs --out on a file system they share)", file=sys.stderr)
             staging.discard()
             return 2
-        client.run(importlib.import_module, tasks.__name__)  # every worker loads the library before the clock
+        try:
+            client.run(importlib.import_module, tasks.__name__)  # every worker loads the library before the clock
+        except ImportError as e:
+            print(f"{prog}: the workers cannot import the sweep ({e}): install the package where they run (pip "
+                  "install '.[sweep]')", file=sys.stderr)
+            staging.discard()
+            return 2
         outputs.preload()
         summary, wall = simulate(args, client, plan, size, staging.folder)
         count = len(range(0, plan.cases.n, size))
