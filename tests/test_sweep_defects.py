@@ -2,10 +2,12 @@
 sweep` decides before Dask starts is checked in-process, with the cluster
 replaced by a failure (an option that is refused must be refused before
 anything runs); the few behaviours that need a process or a cluster run
-one each."""
+one each. Item 3's limit of 1e6 impacts is gone with the columnar sweep
+(issue 26): what remains is the disk, checked before anything runs."""
 
 import os
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -14,6 +16,7 @@ import pytest
 
 import fraccontact
 from fraccontact import sweep
+from fraccontact.sweep import cli, options
 
 pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
                                 reason="Dask workers under a preloaded sanitizer runtime")
@@ -22,19 +25,27 @@ pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
 class Started(Exception):
     """The sweep got as far as starting its cluster."""
 
-    def __init__(self, args, cases):
+    def __init__(self, args, plan):
         super().__init__("the sweep started")
-        self.options, self.cases = args, cases
+        self.options, self.plan = args, plan
+
+
+def every_case(plan):
+    """The cases of a (small) plan, a dict each, as Python numbers."""
+    shown, _ = plan.cases.inputs(0, plan.cases.n)
+    columns = {name: x.tolist() for name, x in shown.items()}
+    return [dict(zip(columns, row)) for row in zip(*columns.values())]
 
 
 @pytest.fixture
 def no_cluster(monkeypatch):
     """sweep.main stops where it would start Dask, with the options and the
-    cases it would run."""
-    def started(args, *rest):
-        raise Started(args, rest[-1])
-    monkeypatch.setattr(sweep, "connect", lambda args: (None, None), raising=False)
-    monkeypatch.setattr(sweep, "run", started)
+    plan it would run."""
+    def started(args, client, plan, *rest):
+        raise Started(args, plan)
+    monkeypatch.setattr(cli, "connect", lambda args: (None, None))
+    monkeypatch.setattr(cli, "close", lambda client, cluster: None)
+    monkeypatch.setattr(cli, "run", started)
 
 
 def refusal(capsys, *args):
@@ -50,7 +61,7 @@ def planned(tmp_path, *args):
     """The options and cases a sweep would run."""
     with pytest.raises(Started) as e:
         sweep.main([*args, "--out", str(tmp_path / "out")])
-    return e.value.options, e.value.cases
+    return e.value.options, every_case(e.value.plan)
 
 
 # ---------------------------------------------------------------- item 3
@@ -67,24 +78,46 @@ def limited_sweep(*args):
 
 
 def test_a_huge_grid_is_refused_before_it_is_built(tmp_path):
-    done = limited_sweep("--vary", "c=1:1e9:1", "--out", str(tmp_path / "out"))
+    """1e15 values: the axis is never built (the process has 2 GiB), and a
+    grid whose output no disk here holds is refused, naming the size."""
+    done = limited_sweep("--vary", "c=1:1e15:1", "--out", str(tmp_path / "out"))
     assert done.returncode == 2, done.stderr[-2000:]
     last = done.stderr.strip().splitlines()[-1]
-    assert "--vary c=1:1e9:1" in last and "1000000000 values" in last and str(sweep.MAX_IMPACTS) in last, last
+    assert "--vary c=1:1e15:1: 1000000000000000 impacts would write about" in last and "free there" in last, last
     assert "Traceback" not in done.stderr and not (tmp_path / "out").exists()
 
 
 def test_a_grid_whose_product_is_too_large_is_refused(no_cluster, tmp_path, capsys):
-    """1001 x 1000 values, each grid small: the product is refused."""
-    code, line = refusal(capsys, "--vary", "c=1:1001:1", "--vary", "k=1e8:1.999e8:1e5", "--out", str(tmp_path))
+    """1e8 x 1e8 values, no axis built: the product is refused."""
+    code, line = refusal(capsys, "--vary", "c=1:1e8:1", "--vary", "k=1e8:1.999e8:1", "--out", str(tmp_path))
     assert code == 2
-    assert "--vary c=1:1001:1 --vary k=1e8:1.999e8:1e5" in line and "1001 x 1000 = 1001000 impacts" in line, line
+    assert "--vary c=1:1e8:1 --vary k=1e8:1.999e8:1: a grid of 100000000 x 99900001 = 9990000100000000 impacts " \
+           "would write about" in line, line
 
 
 def test_a_huge_monte_carlo_is_refused(no_cluster, tmp_path, capsys):
-    code, line = refusal(capsys, "--monte-carlo", "1000001", "--scatter", "c=0.1",
-                         "--out", str(tmp_path))
-    assert code == 2 and "--monte-carlo 1000001: the number of impacts must lie in [1, 1000000]" in line, line
+    code, line = refusal(capsys, "--monte-carlo", str(10 ** 15), "--scatter", "c=0.1", "--out", str(tmp_path))
+    assert code == 2 and "--monte-carlo 1000000000000000: 1000000000000000 impacts would write about" in line, line
+
+
+@pytest.mark.parametrize("csv", [False, True])
+def test_the_disk_bound_is_where_the_help_says(csv, no_cluster, tmp_path, capsys, monkeypatch):
+    """10^8 impacts run (issue 26) when the disk holds their output: c
+    and the 10 results (t_onset, v_onset, F_peak, eps, t_contact, x2_end,
+    E_diss, impacts, steps, k) are 11 values an impact, 8 bytes each in
+    Parquet and 25 more in the CSV; one byte less free is refused."""
+    n = 10 ** 8
+    need = n * 11 * (8 + (25 if csv else 0))
+    args = ["--monte-carlo", str(n), "--scatter", "c=0.1"] + (["--csv"] if csv else [])
+    for free in (need, need - 1):
+        monkeypatch.setattr(options.shutil, "disk_usage", lambda path: shutil._ntuple_diskusage(2 * need, 0, free))
+        if free == need:
+            with pytest.raises(Started) as e:
+                sweep.main(args + ["--out", str(tmp_path / "out")])
+            assert e.value.plan.cases.n == n
+        else:
+            code, line = refusal(capsys, *args, "--out", str(tmp_path / "out"))
+            assert code == 2 and f"--monte-carlo {n}: {n} impacts would write about" in line, line
 
 
 def readme_sweep_section():
@@ -100,7 +133,7 @@ def help_text(capsys):
 
 
 def test_the_limits_are_stated_as_the_code_has_them(capsys):
-    limit = f"at most {sweep.MAX_IMPACTS:,} impacts".replace(",", " ")
+    limit = f"({options.PARQUET_BYTES} bytes a value in Parquet, {options.CSV_BYTES} in the CSV)"
     text = help_text(capsys)
     assert limit in text and f"within {sweep.CONNECT_TIMEOUT} s" in text
     assert limit in readme_sweep_section() and f"within {sweep.CONNECT_TIMEOUT} s" in readme_sweep_section()
@@ -136,7 +169,7 @@ def test_the_warning_is_printed_once_by_a_real_sweep(tmp_path):
     other (the workers' library calls stay quiet), and the rows are the
     same, as the warning says."""
     done = subprocess.run([sys.executable, "-m", "fraccontact", "sweep", "--vary", "E-s=1e9,2e9", "--set", "law=hertz",
-                           "--set", "dt_max=1e-6", "--workers", "1", "--out", str(tmp_path)],
+                           "--set", "dt_max=1e-6", "--workers", "1", "--csv", "--out", str(tmp_path)],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stderr.count("has no effect") == 1, done.stderr
@@ -188,7 +221,7 @@ def test_a_step_doubles_cannot_resolve_is_refused(no_cluster, tmp_path, capsys):
     (["--set", "v=1"], "--set v=1 without --vary"),
     (["--monte-carlo", "5", "--scatter", "c=0.1", "--vary", "k=1e8,2e8"], "--vary k=1e8,2e8 with --monte-carlo"),
     (["--scatter", "c=0.1"], "--scatter c=0.1 without --monte-carlo"),
-    (["--monte-carlo", "0", "--scatter", "c=0.1"], "--monte-carlo 0: the number of impacts must lie in [1,"),
+    (["--monte-carlo", "0", "--scatter", "c=0.1"], "--monte-carlo 0: the number of impacts must be >= 1"),
     (["--monte-carlo", "-3", "--scatter", "c=0.1"], "--monte-carlo -3"),
     (["--set", "c=5000", "--vary", "c=3000,6080"], "--set c=5000 and --vary c=3000,6080: a parameter is either"),
     (["--vary", "c=1,2", "--vary", "c=3"], "--vary c=1,2 and --vary c=3: c is given twice"),
@@ -239,11 +272,11 @@ def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys, monkeypat
     """Nothing listens on port 1: refused after the connect timeout (Dask's
     default is 30 s; 1 s here, to keep the test short), naming the address,
     nothing written."""
-    monkeypatch.setattr(sweep, "CONNECT_TIMEOUT", 1, raising=False)
+    monkeypatch.setattr(options, "CONNECT_TIMEOUT", 1)
     start = time.perf_counter()
     code, line = refusal(capsys, "--scheduler", "tcp://127.0.0.1:1", "--vary", "c=3000,6080",
                          "--out", str(tmp_path / "out"))
-    assert time.perf_counter() - start < sweep.CONNECT_TIMEOUT + 5
+    assert time.perf_counter() - start < options.CONNECT_TIMEOUT + 5
     assert code == 2 and "--scheduler tcp://127.0.0.1:1: no Dask scheduler answered" in line, line
     assert not (tmp_path / "out").exists()
 

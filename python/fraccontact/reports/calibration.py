@@ -30,7 +30,7 @@ PAPER = dict(F_peak=1004.0, eps=0.59, height=0.020, m=H20["m"], k=H20["k"], c=H2
 def heights_sweep(out, k, c, workers=2):
     assert sweep.main(["--vary", "height=0.005:0.1:0.005", "--set", "law=hertz", "--set", f"k={k}", "--set", f"c={c}",
                        "--workers",
-                       str(workers), "--out", str(out)]) == 0
+                       str(workers), "--csv", "--out", str(out)]) == 0
     with open(out / "sweep.csv") as f:
         return [{key: float(v) for key, v in r.items() if key in ("height", "F_peak", "eps", "t_contact", "x2_end")}
                 for r in csv.DictReader(f)]

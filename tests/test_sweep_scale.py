@@ -1,0 +1,418 @@
+"""Issue 26: the columnar sweep. Each task computes its own cases (a slice of
+the grid, or its draws from the seed) and writes them, inputs beside
+results, as a Parquet partition; case i is the same whatever the tasks and
+the workers, so the partitions are the same bytes on 1 or 2 workers, on a
+local cluster or on a `dask scheduler` + `dask worker` started as
+processes, and after a worker dies mid-run. The statistics, computed on the
+workers from the partitions, are numpy's on the same values. The cases in
+process first (fast), then the clusters (seconds each)."""
+
+import csv
+import itertools
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from fractions import Fraction
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import fraccontact
+from fraccontact import sweep
+from fraccontact.sweep import cases, options, outputs, stats, tasks
+
+pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                                reason="Dask workers under a preloaded sanitizer runtime")
+
+TABLE = options.parameter_table()
+
+
+def axis(name, spec):
+    return options.values(TABLE[name], spec)
+
+
+def concatenated(parts):
+    return {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
+
+
+# ---------------------------------------------------------------- cases, in process
+
+
+def test_grid_slices_are_the_grid():
+    """Any split of the index range gives the rows of the full product, as
+    itertools.product and the exact decimals (Fraction) give them; the
+    library is handed law's codes, the partitions its words."""
+    grid = cases.Grid((("height", axis("height", "0.005:0.1:0.005")), ("c", axis("c", "3000,6080")),
+                       ("law", axis("law", "g1,hertz"))))
+    heights = [float(Fraction(5 * i, 1000)) for i in range(1, 21)]
+    expected = list(itertools.product(heights, [3000.0, 6080.0], ["g1", "hertz"]))
+    assert grid.n == len(expected) == 80
+    for cuts in ([0, 80], [0, 7, 30, 79, 80], list(range(81))):
+        parts = [grid.inputs(a, b) for a, b in zip(cuts, cuts[1:])]
+        shown = concatenated([s for s, _ in parts])
+        given = concatenated([g for _, g in parts])
+        assert list(zip(*(shown[k].tolist() for k in ("height", "c", "law")))) == expected
+        assert given["law"].tolist() == [{"g1": 1, "hertz": 2}[law] for *_, law in expected]
+
+
+def test_a_grid_of_tiny_steps_is_exact_on_both_paths():
+    """A grid whose scale exceeds 2^53 takes Python's integers instead of
+    doubles: both give float(Fraction) of each value, to the bit."""
+    fast = axis("R", "1e-13:5e-13:1e-13")
+    slow = cases.Steps(fast.first * 10 ** 6, fast.stride * 10 ** 6, fast.scale * 10 ** 6, fast.n, False)
+    assert slow.scale >= cases.EXACT > fast.scale
+    i = np.arange(fast.n)
+    truth = [float(Fraction(fast.first + j * fast.stride, fast.scale)) for j in range(fast.n)]
+    assert fast.at(i).tolist() == slow.at(i).tolist() == truth == [1e-13, 2e-13, 3e-13, 4e-13, 5e-13]
+
+
+def test_monte_carlo_draws_do_not_depend_on_the_tasks():
+    """Case i's draws are the same whatever the range it is drawn in (block
+    edges crossed and cut), and a parameter's draws do not change when
+    another scatters beside it."""
+    k_alone = cases.MonteCarlo(40000, 7, (("k", 7, 3.3e8, 0.05),))
+    both = cases.MonteCarlo(40000, 7, (("k", 7, 3.3e8, 0.05), ("c", 9, 6080.0, 0.1)))
+    whole, _ = both.inputs(0, both.n)
+    b = cases.BLOCK
+    for cuts in ([0, 40000], [0, 1, b - 1, b + 1, 2 * b, 39999, 40000], [0, 12345, 23456, 40000]):
+        parts = concatenated([both.inputs(x, y)[0] for x, y in zip(cuts, cuts[1:])])
+        assert parts["k"].tobytes() == whole["k"].tobytes() and parts["c"].tobytes() == whole["c"].tobytes()
+    assert k_alone.inputs(0, 40000)[0]["k"].tobytes() == whole["k"].tobytes()
+    assert len(np.unique(whole["k"])) == 40000 and not np.array_equal(whole["k"][:b], whole["k"][b:2 * b])
+
+
+# ---------------------------------------------------------------- statistics, in process
+
+
+def hard_partitions(folder):
+    """Partitions of awkward values: x spans 300 decades of both signs with
+    ties (0 and -0 among them), NaN and infinities (not values), refused
+    rows (left out); n integers with ties; one a constant; s one value."""
+    rng = np.random.default_rng(5)
+    files = []
+    for i, size in enumerate((1, 700, 3000, 50, 2200)):
+        x = np.sign(rng.normal(size=size)) * 10.0 ** rng.uniform(-150, 150, size)
+        x[rng.random(size) < 0.2] = 0.0
+        x[rng.random(size) < 0.05] = -0.0
+        x[rng.random(size) < 0.05] = np.nan
+        x[rng.random(size) < 0.01] = np.inf
+        x[rng.random(size) < 0.3] = 1.5  # ties at the median
+        n = rng.integers(0, 4, size)
+        error = np.where(rng.random(size) < 0.1, "refused", None)
+        single = np.where(np.arange(size) == 0, 2.0, np.nan) if i == 2 else np.full(size, np.nan)
+        table = tasks.pa.table({"x": x, "n": n, "one": np.full(size, 0.626418), "s": single,
+                                "error": tasks.pa.array(error, tasks.pa.string())})
+        files.append(folder / f"part-{i}.parquet")
+        pq.write_table(table, files[-1])
+    return files
+
+
+@pytest.mark.parametrize("gather", [stats.GATHER, 16, 1])
+def test_statistics_are_numpys_on_hard_values(gather, tmp_path, monkeypatch):
+    """The passes in process (a sum for Dask's fold): each percentile is
+    numpy's to the bit (the same order statistics, the same interpolation),
+    gathered at once or after narrowing passes (gather = 16, 1); the
+    mean and std within 1e-12 of the values' size, another summation order
+    (5000 * 2^-53 = 6e-13 at most)."""
+    monkeypatch.setattr(stats, "GATHER", gather)
+    files = hard_partitions(tmp_path)
+    moments = {}
+    for f in files:
+        table = pq.read_table(f)
+        failed = np.flatnonzero(table.column("error").is_valid().to_numpy(zero_copy_only=False))
+        numbers = {name: table.column(name).to_numpy() for name in table.column_names if name != "error"}
+        moments = stats.merged_moments(moments, stats.moments(numbers, failed))
+    passes = []
+
+    def run_pass(requests):
+        passes.append(requests)
+        return stats.finished(stats.combined(*[stats.partition_pass(f, requests) for f in files]), requests)
+    found, _ = stats.summaries(moments, run_pass)
+    table = pq.read_table(files)
+    ok = table.column("error").is_null().to_numpy(zero_copy_only=False)
+    assert set(found) == {"x", "n", "one", "s"}
+    for name, s in found.items():
+        x = table.column(name).to_numpy()[ok].astype(float)
+        x = x[np.isfinite(x)]
+        assert [s["p5"], s["p50"], s["p95"]] == np.percentile(x, [5, 50, 95]).tolist(), name
+        scale = np.abs(x).max()
+        assert s["mean"] == pytest.approx(x.mean(), rel=1e-12, abs=1e-12 * scale), name
+        if len(x) > 1:
+            assert s["std"] == pytest.approx(x.std(ddof=1), rel=1e-12, abs=1e-12 * scale), name
+        else:
+            assert s["std"] is None and name == "s"
+    narrowed = [any(r[0] == "bins" for r in requests) for requests in passes]
+    assert narrowed[0] == (gather < 5000)
+
+
+# ---------------------------------------------------------------- outputs, in process
+
+
+def test_outputs_replace_an_older_run_whole(tmp_path):
+    """The partitions move into place as one folder; an older run's files
+    that this run does not write are removed; a half-written leftover of a
+    dead worker is dropped; nothing hidden is left."""
+    out = tmp_path / "out"
+    (out / "sweep.parquet").mkdir(parents=True)
+    for name in ("sweep.parquet/part-000000.parquet", "sweep.parquet/part-000001.parquet", "sweep.csv",
+                 "sweep.png", "sweep.json"):
+        (out / name).write_text("old")
+    staging = outputs.Staging(out)
+    (staging.folder / "part-000000.parquet").write_text("new")
+    (staging.folder / ".part-000001.parquet.x.tmp").write_text("half")
+    (staging.folder / "sweep.json").write_text("new")
+    staging.commit({"sweep.json"})
+    assert sorted(p.name for p in out.iterdir()) == ["sweep.json", "sweep.parquet"]
+    assert [(p.name, p.read_text()) for p in (out / "sweep.parquet").iterdir()] == [("part-000000.parquet", "new")]
+    assert (out / "sweep.json").read_text() == "new"
+
+
+def test_a_failed_sweep_leaves_nothing(tmp_path):
+    """discard(): the hidden folder goes, and so do the folders the sweep
+    made for --out; an existing --out keeps what it held."""
+    out = tmp_path / "a" / "b"
+    staging = outputs.Staging(out)
+    (staging.folder / "part-000000.parquet").write_text("partial")
+    staging.discard()
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "kept").mkdir()
+    (tmp_path / "kept" / "mine.txt").write_text("x")
+    staging = outputs.Staging(tmp_path / "kept")
+    staging.discard()
+    assert [p.name for p in (tmp_path / "kept").iterdir()] == ["mine.txt"]
+
+
+# ---------------------------------------------------------------- clusters
+
+
+MC = ["--monte-carlo", "12000", "--scatter", "k=0.05", "--scatter", "c=10%", "--set", "law=hertz",
+      "--set", "dt_max=3e-6", "--seed", "4", "--batch", "4000"]  # 3 tasks, whatever the workers
+
+
+def partitions(out):
+    files = sorted((out / "sweep.parquet").iterdir())
+    return [f.name for f in files], [f.read_bytes() for f in files]
+
+
+@pytest.fixture(scope="module")
+def local_runs(tmp_path_factory):
+    """The same campaign on 1 and 2 local workers (the second with --csv)."""
+    out = tmp_path_factory.mktemp("local")
+    assert sweep.main(MC + ["--workers", "1", "--out", str(out / "one")]) == 0
+    assert sweep.main(MC + ["--workers", "2", "--csv", "--out", str(out / "two")]) == 0
+    return out / "one", out / "two"
+
+
+def test_partitions_are_the_same_bytes_on_one_and_two_workers(local_runs):
+    one, two = local_runs
+    names, data = partitions(one)
+    assert names == ["part-000000.parquet", "part-000001.parquet", "part-000002.parquet"]
+    assert partitions(two) == (names, data)
+
+
+def test_the_inputs_are_beside_the_library_results(local_runs):
+    """Each partition holds the drawn inputs, then every result of the
+    library for them: a sample of rows against fraccontact.impact, a run of
+    its own for each (bit for bit: test_package.py)."""
+    table = pq.read_table(local_runs[0] / "sweep.parquet")
+    assert table.column_names == ["k", "c"] + [f"{key}_result" if key == "k" else key for key in sweep.RESULTS] + \
+        ["error"]
+    assert table.num_rows == 12000 and table.column("error").null_count == 12000
+    rows = table.to_pylist()
+    for i in (0, 4999, 5000, 11999):
+        r = fraccontact.impact(k=rows[i]["k"], c=rows[i]["c"], law="hertz", dt_max=3e-6)
+        for key in sweep.RESULTS:
+            assert rows[i][f"{key}_result" if key == "k" else key] == getattr(r, key), (i, key)
+
+
+def test_the_csv_is_written_on_request_with_the_same_rows(local_runs):
+    one, two = local_runs
+    assert not (one / "sweep.csv").exists()
+    with open(two / "sweep.csv") as f:
+        rows = list(csv.DictReader(f))
+    table = pq.read_table(two / "sweep.parquet").to_pylist()
+    assert len(rows) == len(table) == 12000
+    for r, p in zip(rows[::997], table[::997]):
+        assert r["error"] == "" and p["error"] is None
+        assert {k: float(v) for k, v in r.items() if k != "error"} == {k: v for k, v in p.items() if k != "error"}
+
+
+def test_statistics_are_numpys_on_the_partitions(local_runs):
+    """sweep.json's statistics (mean and std within 1e-12 of the values'
+    size, another summation order; percentiles to the bit) over the
+    Parquet partitions' values."""
+    table = pq.read_table(local_runs[1] / "sweep.parquet")
+    found = json.loads((local_runs[1] / "sweep.json").read_text())["statistics"]
+    assert set(found) == set(table.column_names) - {"error"}
+    for name, s in found.items():
+        x = table.column(name).to_numpy().astype(float)
+        x = x[np.isfinite(x)]
+        assert [s["p5"], s["p50"], s["p95"]] == np.percentile(x, [5, 50, 95]).tolist(), name
+        scale = np.abs(x).max()
+        assert s["mean"] == pytest.approx(x.mean(), rel=1e-12, abs=1e-12 * scale), name
+        assert s["std"] == pytest.approx(x.std(ddof=1), rel=1e-12, abs=1e-12 * scale), name
+
+
+def start(*command, env=None):
+    return subprocess.Popen([sys.executable, "-m", "dask", *command], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env=env)
+
+
+def stop(processes):
+    """Ends the cluster's processes, each by its own id: nothing of theirs
+    is worth a graceful close."""
+    for p in processes:
+        if p.poll() is None:
+            p.kill()
+        p.wait()
+
+
+class Cluster:
+    """`dask scheduler` and `dask worker`s started as a user starts them,
+    as processes on the loopback address, without nannies (a worker
+    killed stays dead)."""
+
+    def __init__(self, folder, workers, env=None):
+        self.file = folder / "scheduler.json"
+        self.processes = [start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                "--scheduler-file", str(self.file))]
+        try:
+            self.address = self.wait_for_address()
+            self.workers = [start("worker", self.address, "--host", "127.0.0.1", "--nthreads", "1", "--no-nanny",
+                                  "--no-dashboard", env=env) for _ in range(workers)]
+            self.processes += self.workers
+            from dask.distributed import Client
+            with Client(self.address, timeout=30) as client:
+                client.wait_for_workers(workers, timeout=60)
+        except BaseException:
+            stop(self.processes)
+            raise
+
+    def wait_for_address(self):
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            if self.file.exists():
+                try:
+                    return json.loads(self.file.read_text())["address"]
+                except (ValueError, KeyError):
+                    pass
+            time.sleep(0.1)
+        raise TimeoutError("dask scheduler did not start within 60 s")
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    made = []
+
+    def make(workers, env=None):
+        made.append(Cluster(tmp_path, workers, env))
+        return made[-1]
+    yield make
+    for c in made:
+        stop(c.processes)
+
+
+def test_a_scheduler_and_a_worker_started_as_processes(cluster, local_runs, tmp_path):
+    """--scheduler ADDRESS: the same partitions as the local cluster's."""
+    remote = cluster(1)
+    assert sweep.main(MC + ["--scheduler", remote.address, "--out", str(tmp_path / "out")]) == 0
+    assert partitions(tmp_path / "out") == partitions(local_runs[0])
+
+
+def test_workers_without_the_package_are_refused_in_one_line(cluster, tmp_path, capsys):
+    """A worker started where fraccontact is not installed (no PYTHONPATH
+    to this source tree): one line saying so, exit status 2, nothing
+    written."""
+    remote = cluster(1, env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
+    assert sweep.main(MC + ["--scheduler", remote.address, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "the workers cannot import the sweep" in err[-1] and "pip install" in err[-1], err[-3:]
+    assert not (tmp_path / "out").exists()
+
+
+DEATH = ["--monte-carlo", "1000", "--scatter", "c=10%", "--batch", "50", "--seed", "9"]  # 20 tasks of some 40 ms
+
+
+def test_a_worker_killed_mid_run_loses_nothing(cluster, tmp_path):
+    """One of two workers killed (SIGKILL) once the first partition is
+    written: Dask runs its tasks again on the other, and every partition is
+    the bytes the tasks give without Dask (tasks.run in this process)."""
+    remote = cluster(2)
+    out = tmp_path / "out"
+    sweeping = subprocess.Popen([sys.executable, "-m", "fraccontact", "sweep", *DEATH, "--scheduler", remote.address,
+                                 "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not list(out.glob(".sweep.parquet.*/part-*.parquet")) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        victim = remote.workers[0]
+        victim.send_signal(signal.SIGKILL)
+        stdout, stderr = sweeping.communicate(timeout=120)
+    finally:
+        if sweeping.poll() is None:
+            sweeping.kill()
+            sweeping.wait()
+    assert victim.wait(timeout=10) == -signal.SIGKILL
+    assert sweeping.returncode == 0, stderr[-3000:]
+    assert json.loads(stdout.splitlines()[-1])["impacts"] == 1000
+    args = options.arguments(DEATH + ["--out", str(tmp_path / "reference")], "sweep")[1]
+    plan, size, _ = options.prepared(args)
+    (tmp_path / "reference").mkdir()
+    for i, a, b in cases.ranges(plan.cases.n, size):
+        tasks.run(plan, i, a, b, tmp_path / "reference", False)
+    names, data = partitions(out)
+    assert len(names) == 20
+    assert [(tmp_path / "reference" / name).read_bytes() for name in names] == data
+
+
+# ---------------------------------------------------------------- the README's figures
+
+
+def test_the_readme_quotes_the_scaling_report():
+    """Each figure the README gives of the sweep at scale is the one
+    docs/sweep_scaling.md measured (scripts/report sweep_scaling)."""
+    import re
+    root = os.path.join(os.path.dirname(__file__), "..")
+    doc = open(os.path.join(root, "docs", "sweep_scaling.md")).read()
+    readme = " ".join(open(os.path.join(root, "README.md")).read().split())
+
+    def cell(row, column):
+        line = next(line for line in doc.splitlines() if line.startswith(f"| {row}"))
+        return line.split("|")[column].strip()
+    quoted = [cell("one worker, 10,000,000 impacts, end to end", 4), cell("one worker, 1,000,000 impacts, end to end", 4),
+              cell("serial fraction, one worker, 10,000,000", 4), cell("serial fraction, one worker, 1,000,000", 4),
+              re.search(r"the moments: ([\d.]+ %) more", doc).group(1),
+              f"{cell('client', 2)} for 10^7 impacts against {cell('client', 3)} for 10^5",
+              cell("two workers, 1,000,000 impacts, end to end", 4)]
+    assert "**different**" not in doc and doc.count("(identical)") == 3
+    for figure in quoted:
+        assert figure in readme, figure
+
+
+def test_ctrl_c_stops_the_sweep_and_leaves_nothing(tmp_path):
+    """SIGINT while the tasks run: exit status 130 within seconds, one line
+    saying so, no traceback, and --out (which the sweep made) gone."""
+    out = tmp_path / "out"
+    sweeping = subprocess.Popen([sys.executable, "-m", "fraccontact", "sweep", "--monte-carlo", "10000000",
+                                 "--scatter", "c=10%", "--workers", "1", "--out", str(out)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 60
+        while not list(out.glob(".sweep.parquet.*")) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.5)  # the tasks under way
+        sweeping.send_signal(signal.SIGINT)
+        stopped = time.monotonic()
+        _, stderr = sweeping.communicate(timeout=30)
+    finally:
+        if sweeping.poll() is None:
+            sweeping.kill()
+            sweeping.wait()
+    assert sweeping.returncode == 130 and time.monotonic() - stopped < 10, stderr[-3000:]
+    assert "interrupted; nothing written" in stderr and "Traceback" not in stderr
+    assert not out.exists()
