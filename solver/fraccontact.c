@@ -564,6 +564,11 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
     status = run(p, interval, interval == FC_NO_ROWS ? NULL : &rows, &impacts, &w, &r->outcome, msg, len);
+    if (rows.failed) { /* no half of a time series */
+        free(rows.rows);
+        rows.rows = NULL;
+        rows.n = 0;
+    }
     r->per_impact = impacts.list;
     r->n_impacts = impacts.n;
     r->rows = rows.rows;
