@@ -216,8 +216,8 @@ static double onset_time(const fc_params *p)
     return speed > 0.0 ? 2.0 * p->gap0 / speed : INFINITY;
 }
 
-/* The least a run must cover before it may stop, short of t_end [s]: to its
- * first onset, then its contacts, each at least the elastic contact time at
+/* The least a run must cover before it may stop, short of t_end [s]: none
+ * when the striker never arrives, else to its first onset, then its contacts, each at least the elastic contact time at
  * the first impact's speed (later ones are slower, and longer), all
  * `impacts` of them when an acceleration brings the striker back; the
  * driven scene without mass is in contact until t_end. Of that, *in_contact
@@ -226,6 +226,8 @@ static double least_span(const fc_params *p, double *in_contact)
 {
     double onset = onset_time(p), end = p->t_end, contacts;
     *in_contact = 0.0;
+    if (isinf(onset)) /* it recedes from the start: the run stops at once */
+        return 0.0;
     if (!(onset < end))
         return end;
     contacts = driven_rate(p) ? end : contact_time(p) * (p->g > 0.0 ? (double)p->impacts : 1.0);
