@@ -470,14 +470,23 @@ def test_the_springpots_csv_costs_about_what_its_solve_costs(tmp_path):
     (["--reference", "--law", "g1"], "--law 'g1': --reference solves the continuous law: hertz, or g1 and g1x with "
                                      "--g1-nodes N > 0"),
     (["--reference", "--law", "3"], "--law '3': --reference solves the continuous law"),
-    (["--reference", "--scheme", "central"], "--scheme 'central': --reference takes GSL's steps"),
-    (["--reference", "--dt-max", "1e-8"], "--dt-max '1e-8': --reference takes GSL's steps"),
-    (["--reference", "--tolerance", "1e-6"], "--tolerance '1e-6': --reference takes GSL's steps"),
+    (["--reference", "--scheme", "central"], "--scheme 'central': --reference integrates with GSL, not with a scheme"),
     (["--reference", "--damper", "2"], "--damper '2': --reference integrates the dashpot (damper 1) only"),
     (["--rtol", "1e-9"], "--rtol '1e-9': the relative tolerance of --reference, which is not given")])
 def test_options_the_solve_would_ignore_or_misread_are_refused(args, says):
     """Item 22: one line naming the option, its value and the rule; exit 2."""
     refused(solve(*args, check=False), says)
+
+
+@pytest.mark.parametrize("option, value", [("--dt-max", "1e-8"), ("--tolerance", "1e-6")])
+def test_the_reference_warns_that_the_models_steps_change_nothing(option, value):
+    done = solve("--reference", "--law", "hertz", option, value)
+    assert done.stderr == (f"fraccontact-solve: warning: {option} '{value}' has no effect with --reference: GSL takes "
+                           "its own steps (to --rtol)\n")
+    given, default = solve_json("--reference", "--law", "hertz", option, value), solve_json("--reference", "--law", "hertz")
+    for r in (given, default):
+        del r["cpu_seconds"], r["params"][option[2:].replace("-", "_")]
+    assert given == default
 
 
 def test_the_reference_says_which_law_it_solves():
