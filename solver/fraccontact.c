@@ -216,8 +216,8 @@ static double onset_time(const fc_params *p)
     return speed > 0.0 ? 2.0 * p->gap0 / speed : INFINITY;
 }
 
-/* The least a run must cover before it may stop, short of t_end [s]: to its
- * first onset, then its contacts, each at least the elastic contact time at
+/* The least a run must cover before it may stop, short of t_end [s]: none
+ * when the striker never arrives, else to its first onset, then its contacts, each at least the elastic contact time at
  * the first impact's speed (later ones are slower, and longer), all
  * `impacts` of them when an acceleration brings the striker back; the
  * driven scene without mass is in contact until t_end. Of that, *in_contact
@@ -226,6 +226,8 @@ static double least_span(const fc_params *p, double *in_contact)
 {
     double onset = onset_time(p), end = p->t_end, contacts;
     *in_contact = 0.0;
+    if (isinf(onset)) /* it recedes from the start: the run stops at once */
+        return 0.0;
     if (!(onset < end))
         return end;
     contacts = driven_rate(p) ? end : contact_time(p) * (p->g > 0.0 ? (double)p->impacts : 1.0);
@@ -291,6 +293,73 @@ fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, si
 
 /* ------------------------------------------------------------ a run */
 
+/* The progress callback comes after about this much work, in units of one
+ * internal step of the compressed memory (the dearest step but the full G1
+ * history's): well within a tenth of a second of CPU. */
+#define PROGRESS_WORK 8192
+
+/* A step of the full G1 history sums over every step before it: it costs
+ * about one unit more per this many of them. */
+#define HISTORY_PER_UNIT 64
+
+/* An error-controlled step (ESDIRK, seven stages) costs about this many
+ * units. */
+#define CONTROLLED_STEP_UNITS 4
+
+typedef struct {
+    fc_progress report; /* NULL: none */
+    void *ctx;
+    const contact_model *cm; /* the run's model, and the steps of it counted so far */
+    int64_t counted;
+    int64_t unit;       /* the work of one of its steps, and */
+    int history;        /* whether they sum over the full G1 history */
+    int64_t work, next; /* work done so far, and where the next call falls */
+    int stopped;        /* the callback asked to stop */
+} watch;
+
+static int stop_asked(watch *w, int64_t extra);
+
+/* The model's poll inside a long advance. */
+static int poll_run(void *ctx)
+{
+    return stop_asked(ctx, 0);
+}
+
+/* Watches the run of the model cm from its start. */
+static void watch_run(watch *w, contact_model *cm)
+{
+    w->cm = cm;
+    w->counted = 0;
+    w->unit = contact_error_controlled(&cm->p) ? CONTROLLED_STEP_UNITS : 1;
+    w->history = cm->p.damper == CONTACT_DAMPER_SPRINGPOT && cm->p.memory == CONTACT_MEMORY_G1;
+    if (w->report) {
+        cm->poll = poll_run;
+        cm->poll_ctx = w;
+    }
+}
+
+/* The work of the run's steps from `before` to `after`. */
+static int64_t work_of(const watch *w, int64_t before, int64_t after)
+{
+    return (after - before) * (w->history ? 1 + after / HISTORY_PER_UNIT : w->unit);
+}
+
+/* Counts the model's steps since the last count and `extra` work, and calls
+ * the callback when it is due: 1 when it asks to stop. */
+static int stop_asked(watch *w, int64_t extra)
+{
+    const contact_model *cm = w->cm;
+    if (!w->report)
+        return 0;
+    w->work += work_of(w, w->counted, cm->s.steps) + extra;
+    w->counted = cm->s.steps;
+    if (w->work >= w->next) {
+        w->next = w->work + PROGRESS_WORK;
+        w->stopped = w->stopped || w->report(w->ctx, cm->s.t, cm->s.steps, cm->s.impacts) != 0;
+    }
+    return w->stopped;
+}
+
 /* The model's state as a row of the time series. */
 static void keep(series *s, const contact_model *cm)
 {
@@ -304,28 +373,34 @@ static void keep(series *s, const contact_model *cm)
  * show never changes the steps the run takes. The copy is the last state
  * of the run's own steps before the row: out of contact a recovering
  * springpot's flight is one advance of many steps, which the rows retrace
- * once, step by step, not once a row. Returns the internal steps they took. */
-static int64_t keep_rows_until(series *out, const contact_model *from, double t, double interval, int64_t *k)
+ * once, step by step, not once a row. Their work counts towards w's. */
+static void keep_rows_until(series *out, const contact_model *from, double t, double interval, int64_t *k, watch *w)
 {
     contact_model cursor, at;
     int64_t steps = 0;
     contact_copy(&cursor, from);
-    for (; interval > 0.0 && (double)*k * interval <= t; ++*k) {
+    cursor.poll = NULL; /* the run's: not the rows' steps */
+    for (; interval > 0.0 && (double)*k * interval <= t && !out->failed; ++*k) {
         const double t_row = (double)*k * interval;
         for (;;) {
             contact_copy(&at, &cursor);
             if (!(t_row > at.s.t))
                 break;
             if (isnan(contact_advance_until(&at, t_row - at.s.t, CONTACT_FLIGHT_STEP)))
-                return steps;
+                return;
             steps += 1 + at.s.steps - cursor.s.steps;
+            if (steps >= PROGRESS_WORK) {
+                if (stop_asked(w, steps))
+                    return;
+                steps = 0;
+            }
             if (!(at.s.t < t_row))
                 break;
             contact_copy(&cursor, &at); /* a whole step of the run's short of the row */
         }
         keep(out, &at);
     }
-    return steps;
+    stop_asked(w, steps);
 }
 
 /* The full G1 history lives on its grid and cannot be copied cheaply: its
@@ -341,39 +416,6 @@ static void keep_grid_rows_until(series *out, const contact_model *cm, double in
         return;
     keep(out, cm);
     *k = (int64_t)floor(cm->s.t / interval) + 1;
-}
-
-/* The progress callback comes after about this much work, in units of one
- * internal step of the compressed memory (the dearest step but the full G1
- * history's): well within a tenth of a second of CPU. */
-#define PROGRESS_WORK 8192
-
-/* A step of the full G1 history sums over every step before it: it costs
- * about one unit more per this many of them. */
-#define HISTORY_PER_UNIT 64
-
-typedef struct {
-    fc_progress report; /* NULL: none */
-    void *ctx;
-    int64_t work, next; /* work done so far, and where the next call falls */
-} watch;
-
-/* The work of the steps from `before` to `after` steps of the run. */
-static int64_t work_of(const contact_params *q, int64_t before, int64_t after)
-{
-    if (q->damper == CONTACT_DAMPER_SPRINGPOT && q->memory == CONTACT_MEMORY_G1)
-        return (after - before) * (1 + after / HISTORY_PER_UNIT);
-    return after - before;
-}
-
-/* Counts the work and calls the callback when it is due: 1 when it asks to stop. */
-static int stop_asked(watch *w, int64_t work, const contact_model *cm)
-{
-    w->work += work;
-    if (!w->report || w->work < w->next)
-        return 0;
-    w->next = w->work + PROGRESS_WORK;
-    return w->report(w->ctx, cm->s.t, cm->s.steps, cm->s.impacts) != 0;
 }
 
 /* Why the run stops here, if it does; `slack`: how far short of t_end the
@@ -451,13 +493,14 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     contact_params q;
     contact_model cm, snapshot;
     double E_diss_onset = 0.0;
-    int64_t k = 1, row_steps = 0;
+    int64_t k = 1;
     int uniform, grid;
     memset(o, 0, sizeof *o);
     if (fc_run_check(p, out ? interval : FC_NO_ROWS, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
+    watch_run(w, &cm);
     uniform = contact_steps_uniformly(&cm);
     grid = rows_on_grid(&q);
     if (out)
@@ -475,7 +518,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         rows_inside = out && interval > 0.0 && !grid && (double)k * interval <= cm.s.t + H;
         if (rows_inside)
             contact_copy(&snapshot, &cm); /* no G1 history in it */
-        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION | CONTACT_PAUSE))) {
+        if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
             contact_reject(msg, len, "t", cm.s.t, "the state became non-finite in the step from here [s]");
             return finish(&cm, o, FC_EFAIL);
         }
@@ -494,17 +537,16 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             if (grid)
                 keep_grid_rows_until(out, &cm, interval, &k);
             else if (rows_inside)
-                row_steps = keep_rows_until(out, &snapshot, cm.s.t, interval, &k);
+                keep_rows_until(out, &snapshot, cm.s.t, interval, &k, w);
             if (interval == 0.0 || cm.s.in_contact != before.in_contact)
                 keep(out, &cm);
             if (out->failed)
                 break;
         }
-        if (stop_asked(w, work_of(&q, before.steps, cm.s.steps) + row_steps, &cm)) {
+        if (stop_asked(w, 0)) {
             snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", cm.s.t);
             return finish(&cm, o, FC_ESTOPPED);
         }
-        row_steps = 0;
     }
     if (out) {
         keep(out, &cm);
@@ -519,11 +561,16 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
 {
     series rows = {NULL, 0, 0, 0};
     impact_list impacts = {NULL, 0, 0};
-    watch w = {progress, ctx, 0, PROGRESS_WORK};
+    watch w = {progress, ctx, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0};
     fc_status status;
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
     status = run(p, interval, interval == FC_NO_ROWS ? NULL : &rows, &impacts, &w, &r->outcome, msg, len);
+    if (rows.failed) { /* no half of a time series */
+        free(rows.rows);
+        rows.rows = NULL;
+        rows.n = 0;
+    }
     r->per_impact = impacts.list;
     r->n_impacts = impacts.n;
     r->rows = rows.rows;
@@ -562,7 +609,7 @@ fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outco
 {
     char why[FC_MESSAGE_SIZE];
     batch_watch b = {progress, ctx, 0, n};
-    watch w = {progress ? batch_progress : NULL, &b, 0, PROGRESS_WORK};
+    watch w = {progress ? batch_progress : NULL, &b, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0};
     fc_status first = FC_OK, status = FC_OK;
     size_t i;
     for (i = 0; i < n && status != FC_ESTOPPED; i++) {

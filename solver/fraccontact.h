@@ -188,9 +188,10 @@ typedef int (*fc_progress)(void *ctx, double t, int64_t steps, int64_t impacts);
 /* One run from t = 0 until `impacts` impacts have ended, t_end, or the
  * striker recedes for good: in contact one internal step at a time, free
  * flight in one exact step, as the FMU does. FC_OK, FC_EINVAL (nothing run),
- * FC_EFAIL, FC_ENOMEM or FC_ESTOPPED (the progress callback asked to stop:
- * r holds the run so far), with a message; r is filled in every case (free
- * it). fc_run is fc_run_with_progress without a callback. */
+ * FC_EFAIL, FC_ENOMEM (r then holds no rows) or FC_ESTOPPED (the progress
+ * callback asked to stop: r holds the run so far), with a message; r is
+ * filled in every case (free it). fc_run is fc_run_with_progress without a
+ * callback. */
 FC_API fc_status fc_run(const fc_params *p, double output_interval, fc_result *r, char *msg, size_t len);
 FC_API fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress,
                                       void *ctx, fc_result *r, char *msg, size_t len);

@@ -312,11 +312,12 @@ static const char *typed_value(const option_table *t, const options *o, const ch
     return NULL;
 }
 
-/* The options of one method only: --rtol of --reference; the model's
- * steps, which --reference does not take, and what it cannot solve. */
+/* The options of one method only: --rtol of --reference; what --reference
+ * cannot solve (refused), and the model's steps, which it does not take
+ * (a warning: they change nothing). */
 static int check_method(const option_table *t, options *o)
 {
-    static const char *const own_steps[] = {"--scheme", "--dt-max", "--tolerance"};
+    static const char *const model_steps[] = {"--dt-max", "--tolerance"};
     const char *value;
     size_t i;
     if (!o->reference) {
@@ -327,9 +328,12 @@ static int check_method(const option_table *t, options *o)
         return bad_option("--damper", typed_value(t, o, "--damper"),
                           "--reference integrates the dashpot (damper 1) only: a springpot has no ODE for GSL "
                           "(compare --memory 1 with --memory 2 instead)");
-    for (i = 0; i < sizeof own_steps / sizeof own_steps[0]; i++)
-        if ((value = typed_value(t, o, own_steps[i])))
-            return bad_option(own_steps[i], value, "--reference takes GSL's steps (to --rtol), not the model's");
+    if ((value = typed_value(t, o, "--scheme")))
+        return bad_option("--scheme", value, "--reference integrates with GSL, not with a scheme of the model");
+    for (i = 0; i < sizeof model_steps / sizeof model_steps[0]; i++)
+        if ((value = typed_value(t, o, model_steps[i])))
+            fprintf(stderr, PROGRAM ": warning: %s '%s' has no effect with --reference: GSL takes its own steps (to "
+                    "--rtol)\n", model_steps[i], value);
     if (o->p.law != 2 && o->p.g1_nodes == 0) {
         if ((value = typed_value(t, o, "--law")))
             return bad_option("--law", value,

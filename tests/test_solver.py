@@ -6,7 +6,13 @@ import json
 import math
 import os
 import pathlib
+import pty
+import re
+import resource
+import select
+import signal
 import subprocess
+import time
 
 import pytest
 
@@ -344,3 +350,157 @@ def test_an_underflowing_indentation_is_no_separation(method):
     rebound (it used to end the contact at once with eps = -1)."""
     r = solve_json("--v", "5e-324", "--t-end", 1e-3, *method)
     assert r["impacts"] == 0 and r["end"]["eps"] == 0 and r["stopped"] == "t_end" and r["end"]["v"] == 5e-324
+
+
+# ---------------------------------------------------------------- issue 23: limits, Ctrl-C, rows' cost, options
+
+def solve_limited(*args, seconds=30, cwd=None):
+    """The solver with at most 2 GB of address space and `seconds` of time:
+    code that would take the machine's memory or hours fails instead."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    try:
+        return subprocess.run([SOLVE, *map(str, args)], capture_output=True, text=True, timeout=seconds,
+                              preexec_fn=limit, cwd=cwd)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"still running after {seconds} s")
+
+
+def refused(done, option):
+    """Exit 2, one line on stderr naming the option, nothing on stdout."""
+    assert done.returncode == 2, done.stderr
+    assert done.stdout == "" and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(f"fraccontact-solve: {option}"), done.stderr
+    return done.stderr
+
+
+def test_rows_beyond_what_a_run_keeps_are_refused_up_front(tmp_path):
+    """Item 1: a row every picosecond over h20's contact is 1.2e9 rows."""
+    out = tmp_path / "rows.csv"
+    done = solve_limited("--csv", out, "--output-interval", "1e-12")
+    why = refused(done, "--output-interval '1e-12': output_interval = 1e-12 is invalid: ")
+    assert "1e+07" in why and "raise output_interval" in why
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_output_interval_without_csv_is_refused():
+    refused(solve("--output-interval", "1e-6", check=False), "--output-interval '1e-6': the time between the rows of --csv")
+
+
+@pytest.mark.parametrize("args", [["--dt-max", "1e-15"], ["--dt-max", "1e-13", "--law", "hertz"]])
+def test_a_run_beyond_a_billion_steps_is_refused_up_front(args):
+    """Item 4: --dt-max 1e-15 ran for hours printing nothing."""
+    why = refused(solve_limited(*args), f"--dt-max '{args[1]}': dt_max = {float(args[1]):g} is invalid: ")
+    assert "more than 1e+09" in why and "internal steps" in why
+
+
+LONG_RUN = ["--dt-max", "1e-11"]   # 1.2e8 steps: about ten seconds
+
+
+def test_ctrl_c_stops_a_solve_with_one_line_and_status_130(tmp_path):
+    """Item 4: SIGINT stops the solve within a fraction of a second; nothing
+    is written; one line says why (no progress line off a terminal)."""
+    out = tmp_path / "series.csv"
+    p = subprocess.Popen([SOLVE, *LONG_RUN, "--csv", str(out), "--output-interval", "1e-6"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    ticks = os.sysconf("SC_CLK_TCK")
+    with open(f"/proc/{p.pid}/stat") as f:   # CPU so far: utime and stime, fields 14 and 15
+        asked = sum(int(x) for x in f.read().rsplit(")", 1)[1].split()[11:13]) / ticks
+    p.send_signal(signal.SIGINT)
+    stdout, stderr = p.stdout.read(), p.stderr.read()
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    assert p.returncode == 130, stderr
+    # stopped within a tenth of a second of CPU (and the clock's tick)
+    assert usage.ru_utime + usage.ru_stime - asked < 0.1 + 2 / ticks
+    assert stdout == "" and stderr.count("\n") == 1 and stderr.startswith("fraccontact-solve: interrupted (Ctrl-C) at t = ")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_long_solve_shows_its_progress_on_a_terminal_and_ctrl_c_stops_it():
+    """On a terminal, after a few seconds of CPU, a line on stderr tells how
+    far the solve is; Ctrl-C then stops it (status 130)."""
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: the solver on the terminal
+        os.execv(SOLVE, [SOLVE, *LONG_RUN])
+    seen, start = b"", time.monotonic()
+    try:
+        while b"Ctrl-C stops" not in seen and time.monotonic() - start < 60:
+            if select.select([fd], [], [], 0.1)[0]:
+                seen += os.read(fd, 4096)
+        os.kill(pid, signal.SIGINT)
+        while True:
+            try:
+                chunk = os.read(fd, 4096)
+            except OSError:  # the terminal closed with the solver
+                break
+            if not chunk:
+                break
+            seen += chunk
+    finally:
+        _, status = os.waitpid(pid, 0)
+        os.close(fd)
+    text = seen.decode()
+    assert os.waitstatus_to_exitcode(status) == 130, text
+    assert re.search(r"\r  t = [0-9.e+-]+ s of at most 1 s, [0-9]+ steps, 0 of 1 impacts \(Ctrl-C stops\)", text), text
+    assert "interrupted (Ctrl-C)" in text
+
+
+def test_the_springpots_csv_costs_about_what_its_solve_costs(tmp_path):
+    """Item 6: the issue's run with --csv took 12.3 s of CPU against 0.014 s
+    without; rows may cost about what steps cost. The ratio measured is in
+    the report; 10 is a guard with room for a loaded machine."""
+    args = ["--damper", "2", "--g", "9.81", "--impacts", "3", "--json"]
+    without = json.loads(solve_limited(*args, "--repeat", 5).stdout)
+    done = solve_limited(*args, "--csv", tmp_path / "bounces.csv", "--repeat", 5, seconds=120)
+    with_rows = json.loads(done.stdout)
+    assert with_rows["cpu_seconds"] < 10 * without["cpu_seconds"], (with_rows["cpu_seconds"], without["cpu_seconds"])
+    assert without_timing(with_rows) == without_timing(without)
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--law", "2.0"], "--law '2.0': one of g1, hertz, g1x or 1, 2, 3"),
+    (["--scheme", "2.0"], "--scheme '2.0': one of sdirk2, central or 1, 2"),
+    (["--scene", "3"], "--scene '3': one of drop, driven or 1, 2"),
+    (["--c", "5000", "--c", "6000"], "--c given twice ('5000', then '6000')"),
+    (["--c=5000", "--law", "2", "--c", "5000"], "--c given twice ('5000', then '5000')"),
+    (["--json", "--json"], "--json given twice"),
+    (["--reference", "--law", "g1"], "--law 'g1': --reference solves the continuous law: hertz, or g1 and g1x with "
+                                     "--g1-nodes N > 0"),
+    (["--reference", "--law", "3"], "--law '3': --reference solves the continuous law"),
+    (["--reference", "--scheme", "central"], "--scheme 'central': --reference integrates with GSL, not with a scheme"),
+    (["--reference", "--damper", "2"], "--damper '2': --reference integrates the dashpot (damper 1) only"),
+    (["--rtol", "1e-9"], "--rtol '1e-9': the relative tolerance of --reference, which is not given")])
+def test_options_the_solve_would_ignore_or_misread_are_refused(args, says):
+    """Item 22: one line naming the option, its value and the rule; exit 2."""
+    refused(solve(*args, check=False), says)
+
+
+@pytest.mark.parametrize("option, value", [("--dt-max", "1e-8"), ("--tolerance", "1e-6")])
+def test_the_reference_warns_that_the_models_steps_change_nothing(option, value):
+    done = solve("--reference", "--law", "hertz", option, value)
+    assert done.stderr == (f"fraccontact-solve: warning: {option} '{value}' has no effect with --reference: GSL takes "
+                           "its own steps (to --rtol)\n")
+    given, default = solve_json("--reference", "--law", "hertz", option, value), solve_json("--reference", "--law", "hertz")
+    for r in (given, default):
+        del r["cpu_seconds"], r["params"][option[2:].replace("-", "_")]
+    assert given == default
+
+
+def test_the_reference_says_which_law_it_solves():
+    """Without --law the reference solves the G1 law's continuous limit, the
+    Hertz law, and says so; the same figures as --law hertz to the bit. With
+    a fixed N it solves the G1 law on N intervals (MODEL.md §4): the
+    model's figures at a fine step, not the Hertz law's."""
+    assert solve("--reference").stdout.startswith("reference, law hertz,")
+    hertz = without_timing(solve_json("--reference", "--law", "hertz"))
+    assert without_timing(solve_json("--reference")) == hertz
+    nodes = solve_json("--reference", "--law", "g1", "--g1-nodes", 10)
+    model = solve_json("--law", "g1", "--g1-nodes", 10, "--dt-max", "1e-8")
+    assert nodes["params"]["law"] == 1 and nodes["k"] == model["k"] == K
+    # the model at dt 1e-8 errs by about 1e-11 in F_peak (second order, 1e-9 at 1e-7); 1e-8 is ample
+    assert nodes["F_peak"] == pytest.approx(model["F_peak"], rel=1e-8, abs=0)
+    # N = 10 stiffens the spring by Gamma(11.5)/(Gamma(10) 10^1.5) - 1 = 3.8 %: F_peak differs by percents
+    assert abs(nodes["F_peak"] / hertz["F_peak"] - 1) > 1e-2

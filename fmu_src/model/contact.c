@@ -1654,10 +1654,8 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
                 tau = recover(cm, recovery_step(cm, remaining), &touches);
             }
             remaining -= tau;
-            stopped = (touches && (stop_at & CONTACT_ONSET))
-                      || (remaining > 0.0 && ((stop_at & CONTACT_FLIGHT_STEP)
-                                              || ((stop_at & CONTACT_PAUSE)
-                                                  && cm->s.steps - start.steps >= CONTACT_PAUSE_STEPS)));
+            stopped = (touches && (stop_at & CONTACT_ONSET)) || (remaining > 0.0 && (stop_at & CONTACT_FLIGHT_STEP))
+                      || (cm->poll && cm->s.steps % CONTACT_POLL_STEPS == 0 && cm->poll(cm->poll_ctx));
             continue;
         }
         if (error_controlled(cm)) {

@@ -25,12 +25,15 @@ enum contact_event {
     CONTACT_ONSET = 1,       /* the striker meets the specimen */
     CONTACT_SEPARATION = 2,  /* the force returns to zero: an impact has ended */
     /* Out of contact a recovering springpot's flight is one advance of many
-     * steps: stop after each of them, or after CONTACT_PAUSE_STEPS of them
-     * (for a caller that retraces the steps, or reports progress). */
-    CONTACT_FLIGHT_STEP = 4,
-    CONTACT_PAUSE = 8
+     * steps: stop after each of them (for a caller that retraces them). */
+    CONTACT_FLIGHT_STEP = 4
 };
-#define CONTACT_PAUSE_STEPS 4096
+
+/* Called, when set, at every CONTACT_POLL_STEPS-th internal step (counted
+ * in s.steps) of such a flight, for a caller that must hear from a long
+ * advance: nonzero stops the advance there. */
+typedef int (*contact_poll)(void *ctx);
+#define CONTACT_POLL_STEPS 4096
 
 enum contact_damper {
     CONTACT_DAMPER_DASHPOT = 1,  /* F = c x2' */
@@ -158,6 +161,8 @@ typedef struct {
     double series_limit;    /* an implicit stage's root is its series while (beta^2 r) is below this (stage_root):
                                its error, 20 u^7, is then within 1e-3 of the tolerance; 0: to rounding */
     double peak_force_seen, peak_length; /* error control's cache: a force and its elastic indentation */
+    contact_poll poll;        /* NULL (contact_start), or the caller's */
+    void *poll_ctx;
     contact_state s;
     contact_modes modes;      /* a springpot's compressed memory */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
