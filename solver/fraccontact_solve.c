@@ -154,8 +154,11 @@ static void usage(const option_table *t)
     printf("  %-18s %s\n", "--list-options", "print this table as JSON (option, kind, help, choices) and exit");
     printf("  %-18s %s\n\n", "--help", "this text");
     printf("The solve stops at the first of: --impacts impacts ended, --t-end, or the striker out of\n"
-           "contact moving away with nothing to bring it back (no gravity, say).\n\n"
-           "Output (table, or --json keys):\n"
+           "contact moving away with nothing to bring it back (no gravity, say). A solve that would\n"
+           "take more than %.0e internal steps, or a --csv of more than %.0e rows, is refused up\n"
+           "front (estimated from the elastic contact time at the impact speed).\n\n", FC_STEPS_MAX,
+           (double)FC_ROWS_MAX);
+    printf("Output (table, or --json keys):\n"
            "  t_onset [s], v_onset [m/s], F_peak [N], eps, t_contact [s], x2_end [m], E_diss [J]\n"
            "               the first impact's figures (null when none ended): onset time and speed,\n"
            "               largest force, restitution coefficient, contact duration, the permanent\n"

@@ -331,8 +331,8 @@ BOUNCES = dict(damper=2, g=9.81, impacts=3)   # the issue's springpot run
 
 def test_the_springpots_rows_cost_about_what_its_steps_cost():
     """36 612 rows (the default spacing) over 49 042 steps: the rows may
-    cost about what steps cost, not 500-1500 times the solve. The measured
-    ratio is in docs (the issue's figures); 10 is a guard with room for a
+    cost about what steps cost, not 500-1500 times the solve (the issue's
+    figures; about 2 times measured now); 10 is a guard with room for a
     loaded machine."""
     _, _, _, without = min((rows_and_impacts(-1.0, **BOUNCES) for _ in range(3)), key=lambda r: r[3])
     rows, _, outcome, with_rows = min((rows_and_impacts(-2.0, **BOUNCES) for _ in range(3)), key=lambda r: r[3])
