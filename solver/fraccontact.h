@@ -61,7 +61,7 @@ typedef struct {
     double c_alpha;          /* springpot constant [N s^alpha/m] */
     double memory_tolerance; /* relative error of the compressed memory's kernel */
     double tolerance;        /* relative error per internal step; 0: fixed steps of dt_max */
-    double dt_max;   /* largest internal step [s] */
+    double dt_max;   /* largest internal step [s]; 0: fixed steps of 1e-7 s, error-controlled ones uncapped */
     double g;        /* acceleration of the striker towards the specimen [m/s^2] */
     double gap0;     /* gap between striker and specimen at t = 0 [m] */
     double t_end;    /* stop at this time [s] */
@@ -75,7 +75,7 @@ typedef struct {
 } fc_params;
 
 /* The paper's h20 drop test (MODEL.md §6): v = sqrt(2 9.81 0.020), m =
- * 0.7437, k = 3.299e8, c = 6080, dt_max = 1e-7, G1 law; one impact, t_end 1 s. */
+ * 0.7437, k = 3.299e8, c = 6080, dt_max = 0 (fixed steps of 1e-7 s), G1 law; one impact, t_end 1 s. */
 FC_API void fc_params_default(fc_params *p);
 
 /* FC_OK, or FC_EINVAL and a message naming the first parameter that breaks

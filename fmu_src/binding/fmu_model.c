@@ -49,6 +49,10 @@ struct fmu_model {
 
 #define PARAM(field) offsetof(fmu_model, params.field)
 
+/* The most internal steps one communication step may take: about a minute
+ * of CPU; beyond that a step is a mistake, not a wish. */
+#define MAX_STEPS 1000000000
+
 static const fmu_variable variable_list[] = {
     {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v)},
     {VR_m, "m", VAR_REAL, VAR_INPUT, offsetof(fmu_model, m)},
@@ -174,10 +178,13 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
         return FM_ERROR;
     if (var->causality == VAR_PARAMETER)
         return set_parameter(fm, var, &value, sizeof value);
-    /* Inputs: the scene-dependent rule (m > 0 in the drop test) waits for
-     * fm_start, since the scene may still change. */
+    /* Inputs: the rules that depend on the scene (m > 0 in the drop test)
+     * or on other parameters (a uniform grid's resolution) wait for
+     * fm_start, since those may still change. */
     if (contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
-                              vr == VR_m ? value : fm->m, why, sizeof why) != 0)
+                              vr == VR_m ? value : fm->m, why, sizeof why) != 0
+        || (fm->started && contact_check_resolution(&fm->params, vr == VR_v ? value : fm->v,
+                                                    vr == VR_m ? value : fm->m, why, sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     *(double *)((char *)fm + var->offset) = value;
     if (vr == VR_v)
@@ -307,14 +314,19 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     return FM_OK;
 }
 
-fm_status fm_start(fmu_model *fm, double t0)
+fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
     char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
-        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
+        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0
+        || contact_check_resolution(&fm->params, fm->v, fm->m, why, sizeof why) != 0
+        || (isfinite(t_stop)
+            && contact_check_history_span(&fm->params, fm->v, fm->m, t_stop - t0, 0, "stopTime - startTime", why,
+                                          sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_release(&fm->model);
     contact_start(&fm->model, &fm->params, fm->v, fm->m);
+    fm->model.max_steps = MAX_STEPS;
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
     fm->step_span = 0.0;
@@ -326,7 +338,8 @@ fm_status fm_start(fmu_model *fm, double t0)
     fm->next.valid = 0;
     fm->held = 0;
     fm->started = 1;
-    if (contact_unused_value(&fm->params, why, sizeof why))
+    if (contact_unused_value(&fm->params, why, sizeof why)
+        || contact_step_warning(&fm->params, fm->v, fm->m, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     if (fm->coupling != COUPLING_GAUSS_SEIDEL && fm->params.scene == CONTACT_SCENE_DROP)
         return report(fm, FM_WARNING, "logStatusWarning",
@@ -465,12 +478,13 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
     int from_prediction;
     *event = 0;
-    /* A refused step changes nothing, so the checks come first. About a
-     * minute of CPU: beyond that a step is a mistake, not a wish. */
-    if (H / fm->params.dt_max > 1e9)
+    /* A refused step changes nothing, so the checks come first: a uniform
+     * grid's steps are known in advance (the others' are counted as they
+     * are taken: MAX_STEPS, the model's max_steps). */
+    if (contact_steps_uniformly(cm) && H / cm->h_max > MAX_STEPS)
         return report(fm, FM_ERROR, "logStatusError",
-                      "DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
-                      "of dt_max = %g; take shorter communication steps or a larger dt_max", H, fm->params.dt_max);
+                      "DoStep: communicationStepSize = %g takes more than 1e9 internal steps of dt_max = %g s on "
+                      "the uniform grid; take shorter communication steps or a larger dt_max", H, cm->h_max);
     if (H > 0.0 && contact_check_advance(cm, H, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
     fm_update_discrete(fm); /* a new step: the master has seen the last event */
@@ -500,6 +514,11 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->step_start = step_start;
         fm->step_H = step_H;
         fm->next.valid = 0;
+        if (cm->exceeded)
+            return report(fm, FM_ERROR, "logStatusError",
+                          "DoStep: communicationStepSize = %g from t = %.17g s took more than 1e9 internal steps "
+                          "(about a minute of CPU) and was stopped; the state is kept at the start of the step "
+                          "(take shorter communication steps, a larger dt_max or tolerance > 0)", H, t);
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: the state became non-finite in [%.17g, %.17g] s; "
                       "it is kept at the start of the step", t, t + H);
@@ -663,6 +682,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         if (!isfinite(serial_get_double(memory + 8 * i)))
             return report(fm, FM_ERROR, "logStatusError", "the FMU state's damper memory holds a non-finite value");
     contact_configure(&trial.model, &trial.params);
+    trial.model.max_steps = MAX_STEPS;
     if (nonfinite_output(&trial))
         return report(fm, FM_ERROR, "logStatusError", "the FMU state gives the output %s a non-finite value",
                       nonfinite_output(&trial)->name);
