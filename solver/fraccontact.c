@@ -245,6 +245,8 @@ static int why_stop(const fc_params *p, const contact_model *cm, double slack)
         return FC_STOP_IMPACTS;
     if (cm->s.t >= p->t_end - slack)
         return FC_STOP_T_END;
+    if (cm->s.in_contact)
+        return contact_rests(cm) ? FC_STOP_RESTING : 0;
     return contact_never_returns(cm) ? FC_STOP_RECEDING : 0;
 }
 

@@ -40,7 +40,8 @@ typedef enum {
 typedef enum {
     FC_STOP_IMPACTS = 1,  /* the requested number of impacts ended */
     FC_STOP_T_END = 2,    /* the time limit came first */
-    FC_STOP_RECEDING = 3  /* out of contact, and nothing brings the striker back */
+    FC_STOP_RECEDING = 3, /* out of contact, and nothing brings the striker back */
+    FC_STOP_RESTING = 4   /* in contact, at rest for good: an overdamped contact that never separates */
 } fc_stop;
 
 #define FC_MESSAGE_SIZE 512

@@ -41,6 +41,7 @@ struct fmu_model {
     int started;          /* past initialization: fixed parameters are frozen */
     int held;             /* a step stopped at an event: the discrete outputs show */
     int held_contact;     /* their values from before it until fm_update_discrete */
+    int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
     contact_model model;
     prediction next;
@@ -412,20 +413,36 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
  * ignores never exceeds this fraction. */
 #define SAME_MOTION 1e-12
 
+/* Whether the master's velocity v, read as the coupling it names, is the
+ * proxy's own motion ending at v_end (SAME_MOTION). */
+static int same_motion(const fmu_model *fm, double v, double v_end)
+{
+    return fabs(v - v_end) <= SAME_MOTION * fmax(fmax(fabs(v), fabs(v_end)), fabs(fm->model.s.v_onset));
+}
+
 /* The velocity the step starts from. The master's v, except for a proxy
  * striker (driven scene, m > 0): with the Jacobi coupling less the impulse
  * owed (the striker has not yet received it), and its own end velocity
  * v_end when the master's agrees with it to rounding (SAME_MOTION). A
- * deterministic function of the state and the inputs, so that a memo of
- * the step (the prediction) may be dropped without changing a result. */
-static double start_velocity(const fmu_model *fm, double v_end)
+ * master that feeds the other force than `coupling` says (F_avg_next with
+ * coupling = 1, F_avg with 2) shows it where its v is the proxy's motion
+ * read as the other coupling: the proxy then follows its own motion too,
+ * and *other says so. A deterministic function of the state and the
+ * inputs, so that a memo of the step (the prediction) may be dropped
+ * without changing a result. */
+static double start_velocity(const fmu_model *fm, double v_end, int *other)
 {
-    double v = fm->v;
+    double jacobi, gauss_seidel, v;
+    *other = 0;
     if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->m > 0.0))
-        return v;
-    if (fm->coupling == COUPLING_JACOBI)
-        v -= fm->owed / fm->m;
-    return fabs(v - v_end) <= SAME_MOTION * fmax(fmax(fabs(v), fabs(v_end)), fabs(fm->model.s.v_onset)) ? v_end : v;
+        return fm->v;
+    jacobi = fm->v - fm->owed / fm->m;
+    gauss_seidel = fm->v;
+    v = fm->coupling == COUPLING_JACOBI ? jacobi : gauss_seidel;
+    if (same_motion(fm, v, v_end))
+        return v_end;
+    *other = same_motion(fm, fm->coupling == COUPLING_JACOBI ? gauss_seidel : jacobi, v_end);
+    return *other ? v_end : v;
 }
 
 /* The next step, of length H from the model's state as the last step left
@@ -476,7 +493,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
                  announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
-    int from_prediction;
+    int from_prediction, other_coupling;
     *event = 0;
     /* A refused step changes nothing, so the checks come first: a uniform
      * grid's steps are known in advance (the others' are counted as they
@@ -499,7 +516,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     t_start = cm->s.t;
     v_end = cm->s.v;
-    contact_drive(cm, start_velocity(fm, v_end), fm->m, fm->v_slope);
+    contact_drive(cm, start_velocity(fm, v_end, &other_coupling), fm->m, fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
@@ -578,6 +595,17 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->held_eps = before.eps;
     }
     report_events(fm, &before);
+    if (other_coupling && !fm->coupling_warned) {
+        fm->coupling_warned = 1;
+        return report(fm, FM_WARNING, "logStatusWarning",
+                      "coupling = %d, but the master's v at t = %.9g s follows %s: the proxy striker follows its "
+                      "own motion; set coupling = %d (with a force on the striker the FMU does not know, such as "
+                      "gravity in the master's striker, only the right coupling gives the right force)",
+                      fm->coupling, t,
+                      fm->coupling == COUPLING_JACOBI ? "F_avg fed after this FMU's step (Gauss-Seidel)"
+                                                      : "F_avg_next fed before it (Jacobi)",
+                      fm->coupling == COUPLING_JACOBI ? COUPLING_GAUSS_SEIDEL : COUPLING_JACOBI);
+    }
     return FM_OK;
 }
 

@@ -1859,6 +1859,13 @@ int contact_never_returns(const contact_model *cm)
     return 1;
 }
 
+int contact_rests(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    return s->in_contact && !springpot(cm) && cm->accel == 0.0 && s->F <= DBL_EPSILON * s->F_peak_contact
+           && fabs(s->v) <= DBL_EPSILON * fabs(s->v_onset);
+}
+
 double contact_elastic_indentation(const contact_model *cm)
 {
     return cm->s.x1 > 0.0 ? cm->s.x1 : 0.0;

@@ -319,6 +319,14 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at);
  * clear of the undeformed surface): nothing it feels changes from then on. */
 int contact_never_returns(const contact_model *cm);
 
+/* Whether the striker has come to rest in contact for good: nothing loads
+ * it (no acceleration apart from the contact force), the damper is the
+ * dashpot (a springpot's memory would still move it), and the force and the
+ * striker's speed have fallen below the rounding of the contact's peak
+ * force and onset speed. An overdamped contact creeps to rest this way and
+ * never separates; nothing it reports changes any more. */
+int contact_rests(const contact_model *cm);
+
 /* Outputs derived from the state. */
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */
 double contact_total_indentation(const contact_model *cm);    /* x = x1 + x2 */

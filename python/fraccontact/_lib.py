@@ -14,7 +14,7 @@ SUFFIX = {"win32": ".dll", "darwin": ".dylib"}.get(sys.platform, ".so")
 PREFIX = "" if sys.platform == "win32" else "lib"
 
 FC_OK, FC_EINVAL, FC_EFAIL, FC_ENOMEM = 0, 1, 2, 3
-STOPS = {1: "impacts", 2: "t_end", 3: "receding"}
+STOPS = {1: "impacts", 2: "t_end", 3: "receding", 4: "resting"}
 NO_ROWS, EVERY_STEP, DEFAULT_ROWS = -1.0, 0.0, -2.0
 COLUMNS = ("t", "F", "x", "x1", "x2", "v", "E_diss")
 MESSAGE_SIZE = 512
