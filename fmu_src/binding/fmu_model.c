@@ -595,9 +595,10 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->held_eps = before.eps;
     }
     report_events(fm, &before);
+    /* logged as a warning; the step itself went as it should */
     if (other_coupling && !fm->coupling_warned) {
         fm->coupling_warned = 1;
-        return report(fm, FM_WARNING, "logStatusWarning",
+        report(fm, FM_WARNING, "logStatusWarning",
                       "coupling = %d, but the master's v at t = %.9g s follows %s: the proxy striker follows its "
                       "own motion; set coupling = %d (with a force on the striker the FMU does not know, such as "
                       "gravity in the master's striker, only the right coupling gives the right force)",
