@@ -157,6 +157,13 @@ size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, do
     return cm.modes.modes;
 }
 
+double fc_step_limit(const fc_params *p)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    return contact_step_limit(&q);
+}
+
 double fc_drop_velocity(double height)
 {
     return sqrt(2.0 * 9.81 * height);

@@ -94,6 +94,11 @@ FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
  * 0 when it takes fixed steps of dt_max. */
 FC_API int fc_error_controlled(const fc_params *p);
 
+/* The largest internal step of these parameters [s]: dt_max, or for
+ * dt_max = 0 the fixed step of 1e-7 s, or INFINITY where error-controlled
+ * steps have no cap. */
+FC_API double fc_step_limit(const fc_params *p);
+
 /* What fc_parameter_at tells of each member of fc_params. */
 typedef enum { FC_REAL = 0, FC_INTEGER = 1 } fc_kind;
 

@@ -458,7 +458,7 @@ static void predict(fmu_model *fm, double H)
      * predicted steps first, so that the copy never reallocates it. */
     if (contact_check_advance(cm, H, why, sizeof why) != 0
         || (contact_steps_uniformly(cm)
-            && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->p.dt_max + 0.5)) != 0))
+            && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->h_max + 0.5)) != 0))
         return;
     contact_copy(&p->model, cm);
     p->impulse = contact_advance(&p->model, H);

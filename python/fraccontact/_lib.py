@@ -57,6 +57,7 @@ def _load():
     lib.fc_drop_velocity.restype = ctypes.c_double
     lib.fc_drop_velocity.argtypes = [ctypes.c_double]
     lib.fc_default_output_interval.restype = ctypes.c_double
+    lib.fc_step_limit.restype = ctypes.c_double
     return lib
 
 

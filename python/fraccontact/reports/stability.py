@@ -42,7 +42,7 @@ from ..progress import progress
 
 H20 = model.defaults()
 # The paper's h20 test; a case changes some of these (v0 is the library's v, dt its dt_max).
-BASE = dict(c=H20["c"], E_s=H20["E_s"], v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g1_nodes=0, gap0=0.0, g=0.0,
+BASE = dict(c=H20["c"], E_s=H20["E_s"], v0=H20["v"], m=H20["m"], dt=model.step_limit(), g1_nodes=0, gap0=0.0, g=0.0,
             impacts=1)
 MAX_STEPS = 4e7  # per run: keeps the matrix to minutes
 ULP = sys.float_info.epsilon
@@ -558,7 +558,7 @@ def convergence(program, name, case, law):
 SP_OMEGA = 2400.0  # [rad/s] the h20 impact's frequency pi/t_c (MODEL.md §7)
 SP_MEMORY1_STEPS = 50000
 SP_X_REF = hertz.indentation(H20["k"], H20["m"], H20["v"])  # the h20 Hertz impact's x_max
-SP_BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g=0.0, gap0=0.0, impacts=1,
+SP_BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=model.step_limit(), g=0.0, gap0=0.0, impacts=1,
                t_end=0.0, tolerance=H20["memory_tolerance"], memory1_steps=SP_MEMORY1_STEPS)
 SP_QUANTITIES = ("F_peak", "eps", "t_contact", "E_diss", "v_onset", "x2", "v", "E_end")
 # Compared at t_end (when both runs stopped there): an error that may grow
