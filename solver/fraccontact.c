@@ -27,11 +27,14 @@ static const fc_parameter parameters[] = {
     {"damper_order", FC_REAL, AT(damper_order), "1", "the springpot's order alpha in (0, 1]; 1 is a dashpot (damper 2)"},
     {"c_alpha", FC_REAL, AT(c_alpha), "N.s^alpha/m", "springpot constant: F = c_alpha D^alpha x2 (damper 2)"},
     {"memory_tolerance", FC_REAL, AT(memory_tolerance), "1",
-     "relative error of the compressed memory's kernel, from dt_max (error-controlled steps: from min(dt_max, 1e-9 s)) "
-     "to 1000 s (memory 2)"},
+     "relative error of the compressed memory's kernel, from the fixed step (error-controlled steps: from min(dt_max, "
+     "1e-9 s)) to 1000 s (memory 2)"},
     {"tolerance", FC_REAL, AT(tolerance), "1",
-     "relative error per internal step (error-controlled ESDIRK steps of at most dt_max); 0 = fixed steps of dt_max"},
-    {"dt_max", FC_REAL, AT(dt_max), "s", "largest internal step"},
+     "relative error per internal step (error-controlled ESDIRK steps, capped by dt_max only when dt_max > 0); 0 = "
+     "fixed steps of dt_max"},
+    {"dt_max", FC_REAL, AT(dt_max), "s",
+     "largest internal step; 0 = fixed steps of 1e-7 s and no cap on error-controlled steps; in contact, where fewer "
+     "than 6 fixed steps would fit in the time the spring takes to stop the striker, they are 4000 in that time"},
     {"g", FC_REAL, AT(g), "m/s2", "acceleration of the striker towards the specimen (9.81 for gravity)"},
     {"gap0", FC_REAL, AT(gap0), "m", "gap between striker and specimen at t = 0"},
     {"t_end", FC_REAL, AT(t_end), "s", "stop at this time if the run has not stopped before"},
@@ -115,7 +118,8 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;
     fc_model_params(p, &q);
-    if (contact_check_params(&q, msg, len) != 0 || contact_check_striker(&q, q.scene, p->v, p->m, msg, len) != 0)
+    if (contact_check_params(&q, msg, len) != 0 || contact_check_striker(&q, q.scene, p->v, p->m, msg, len) != 0
+        || contact_check_resolution(&q, p->v, p->m, msg, len) != 0)
         return FC_EINVAL;
     if (!(p->t_end > 0.0) || !isfinite(p->t_end)) {
         contact_reject(msg, len, "t_end", p->t_end, "the time limit must be positive and finite [s]");
@@ -125,6 +129,11 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
         contact_reject(msg, len, "impacts", p->impacts, "the number of impacts to stop after must be >= 1");
         return FC_EINVAL;
     }
+    /* A run stops at its first separation after one impact, or where
+     * nothing brings the striker back. */
+    if (contact_check_history_span(&q, p->v, p->m, p->t_end, p->impacts == 1 || !(p->g > 0.0), "t_end", msg, len)
+        != 0)
+        return FC_EINVAL;
     return FC_OK;
 }
 
@@ -138,6 +147,7 @@ size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, do
     fc_model_params(p, &q);
     q.damper = CONTACT_DAMPER_SPRINGPOT;
     q.memory = CONTACT_MEMORY_COMPRESSED;
+    memset(&cm, 0, sizeof cm);
     contact_configure(&cm, &q);
     if (cm.modes.modes <= max)
         for (i = 0; i < cm.modes.modes; i++) {
@@ -146,6 +156,13 @@ size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, do
         }
     *eta = cm.modes.eta;
     return cm.modes.modes;
+}
+
+double fc_step_limit(const fc_params *p)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    return contact_step_limit(&q);
 }
 
 double fc_drop_velocity(double height)
@@ -157,7 +174,7 @@ int fc_params_warning(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;
     fc_model_params(p, &q);
-    return contact_unused_value(&q, msg, len);
+    return contact_unused_value(&q, msg, len) || contact_step_warning(&q, p->v, p->m, msg, len);
 }
 
 int fc_error_controlled(const fc_params *p)
@@ -427,6 +444,8 @@ static int why_stop(const fc_params *p, const contact_model *cm, double slack)
         return FC_STOP_IMPACTS;
     if (cm->s.t >= p->t_end - slack)
         return FC_STOP_T_END;
+    if (cm->s.in_contact)
+        return contact_rests(cm) ? FC_STOP_RESTING : 0;
     return contact_never_returns(cm) ? FC_STOP_RECEDING : 0;
 }
 
@@ -495,26 +514,28 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     double E_diss_onset = 0.0;
     int64_t k = 1;
     int uniform, grid;
+    double dt;
     memset(o, 0, sizeof *o);
     if (fc_run_check(p, out ? interval : FC_NO_ROWS, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
+    dt = contact_step_limit(&q);
     contact_start(&cm, &q, p->v, p->m);
     watch_run(w, &cm);
     uniform = contact_steps_uniformly(&cm);
     grid = rows_on_grid(&q);
     if (out)
         keep(out, &cm);
-    while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * q.dt_max : 0.0))) {
+    while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * dt : 0.0))) {
         const contact_state before = cm.s;
         double H = p->t_end - cm.s.t;
         int rows_inside;
         if (grid) {
-            H = q.dt_max;
+            H = dt;
             if (contact_check_advance(&cm, H, msg, len) != 0)
                 return finish(&cm, o, FC_EFAIL);
         } else if (cm.s.in_contact || uniform)
-            H = fmin(H, q.dt_max);
+            H = fmin(H, dt);
         rows_inside = out && interval > 0.0 && !grid && (double)k * interval <= cm.s.t + H;
         if (rows_inside)
             contact_copy(&snapshot, &cm); /* no G1 history in it */

@@ -41,7 +41,8 @@ typedef enum {
 typedef enum {
     FC_STOP_IMPACTS = 1,  /* the requested number of impacts ended */
     FC_STOP_T_END = 2,    /* the time limit came first */
-    FC_STOP_RECEDING = 3  /* out of contact, and nothing brings the striker back */
+    FC_STOP_RECEDING = 3, /* out of contact, and nothing brings the striker back */
+    FC_STOP_RESTING = 4   /* in contact, at rest for good: an overdamped contact that never separates */
 } fc_stop;
 
 #define FC_MESSAGE_SIZE 512
@@ -62,7 +63,7 @@ typedef struct {
     double c_alpha;          /* springpot constant [N s^alpha/m] */
     double memory_tolerance; /* relative error of the compressed memory's kernel */
     double tolerance;        /* relative error per internal step; 0: fixed steps of dt_max */
-    double dt_max;   /* largest internal step [s] */
+    double dt_max;   /* largest internal step [s]; 0: fixed steps of 1e-7 s, error-controlled ones uncapped */
     double g;        /* acceleration of the striker towards the specimen [m/s^2] */
     double gap0;     /* gap between striker and specimen at t = 0 [m] */
     double t_end;    /* stop at this time [s] */
@@ -76,7 +77,7 @@ typedef struct {
 } fc_params;
 
 /* The paper's h20 drop test (MODEL.md §6): v = sqrt(2 9.81 0.020), m =
- * 0.7437, k = 3.299e8, c = 6080, dt_max = 1e-7, G1 law; one impact, t_end 1 s. */
+ * 0.7437, k = 3.299e8, c = 6080, dt_max = 0 (fixed steps of 1e-7 s), G1 law; one impact, t_end 1 s. */
 FC_API void fc_params_default(fc_params *p);
 
 /* FC_OK, or FC_EINVAL and a message naming the first parameter that breaks
@@ -93,6 +94,11 @@ FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 /* 1 when the run chooses its steps by p->tolerance (Kvaerno's ESDIRK 5(4)),
  * 0 when it takes fixed steps of dt_max. */
 FC_API int fc_error_controlled(const fc_params *p);
+
+/* The largest internal step of these parameters [s]: dt_max, or for
+ * dt_max = 0 the fixed step of 1e-7 s, or INFINITY where error-controlled
+ * steps have no cap. */
+FC_API double fc_step_limit(const fc_params *p);
 
 /* What fc_parameter_at tells of each member of fc_params. */
 typedef enum { FC_REAL = 0, FC_INTEGER = 1 } fc_kind;

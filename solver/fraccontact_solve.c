@@ -168,7 +168,8 @@ static void usage(const option_table *t)
            "  end          the FMU's outputs where the solve stopped: t [s], F_peak [N] (the largest\n"
            "               of the solve), eps and t_contact [s] (of the last finished impact), E_diss [J]\n"
            "               (of all impacts), x, x1, x2 [m], v [m/s] (the striker's velocity)\n"
-           "  stopped      why the solve stopped: impacts, t_end or receding\n"
+           "  stopped      why the solve stopped: impacts, t_end, receding, or resting (in contact, at rest\n"
+           "               for good: an overdamped contact that never separates)\n"
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
@@ -495,7 +496,8 @@ static int write_csv_rows(const char *tmp, const char *path, const double *rows,
 
 static const char *stop_name(int stop)
 {
-    return stop == FC_STOP_IMPACTS ? "impacts" : stop == FC_STOP_T_END ? "t_end" : "receding";
+    return stop == FC_STOP_IMPACTS ? "impacts" : stop == FC_STOP_T_END ? "t_end" : stop == FC_STOP_RESTING ? "resting"
+                                                                                                  : "receding";
 }
 
 static const char *method_name(const options *o)
@@ -562,7 +564,9 @@ static void print_table(const options *o, const fc_result *r, double cpu_seconds
 {
     static const char *const laws[] = {"", "g1", "hertz", "g1x"};
     static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
-                                        "the striker moves away and nothing brings it back"};
+                                        "the striker moves away and nothing brings it back",
+                                        "the striker came to rest in contact: the force decayed without a "
+                                        "separation"};
     const fc_outcome *f = &r->outcome;
     size_t i;
     printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.law], f->k, o->p.spring_exponent);

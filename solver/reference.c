@@ -132,6 +132,18 @@ static int never_returns(contact_model *cm, const double y[4])
     return contact_never_returns(cm);
 }
 
+/* Whether the striker, in contact at y, has come to rest for good (the
+ * model's own test, on the reference's state). */
+static int rests(contact_model *cm, const ode *o, const double y[4], double v_onset, double F_peak_contact)
+{
+    cm->s.in_contact = 1;
+    cm->s.F = force(o, y[0]);
+    cm->s.F_peak_contact = F_peak_contact;
+    cm->s.v = y[1];
+    cm->s.v_onset = v_onset;
+    return contact_rests(cm);
+}
+
 /* Samples at k out_dt in (t, t1], integrated from the bracket's start; their
  * right-hand-side evaluations are not the solve's. */
 static void sample_until(integrator *in, double t, const double y[4], double t1, double out_dt, long *k,
@@ -230,7 +242,8 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
         r->stop = r->impacts >= params->impacts ? FC_STOP_IMPACTS
                   : t >= t_end          ? FC_STOP_T_END
                   : !in_contact && never_returns(&cm, y) ? FC_STOP_RECEDING
-                                                          : 0;
+                  : in_contact && rests(&cm, &o, y, v_onset, F_peak_contact) ? FC_STOP_RESTING
+                                                                            : 0;
         if (r->stop)
             break;
         t1 = fmin(t + bracket, t_end);

@@ -158,8 +158,9 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
                    "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x and v, order 1", vr, order);
 }
 
-fm_status fm_start(fmu_model *fm, double t0)
+fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
+    (void)t_stop;
     fm->t = t0;
     fm->x = fm->x0;
     fm->v = fm->v0;

@@ -141,10 +141,12 @@ static void test_elastic_limit(void)
  * still fail (a fix shows up here: remove the entry); every other run must
  * pass. ENERGY: SDIRK2 gains energy in nearly elastic Hertz impacts, about
  * 0.2 (dt/t_c)^2.5 (9 ulp per step at c = 1e9, dt = 1e-7; eps > 1 at
- * dt = 1e-4). FORCE: its stability function is negative for lambda dt >
- * 2.41 (lambda the dashpot's relaxation rate), so across a stiff dashpot
- * the force overshoots c v0, which the model's never exceeds (29 % at c = 1,
- * dt = 1e-5). */
+ * dt = 1e-4, the coarsest step that still resolves the impact: a coarser
+ * one is refined to CONTACT_REFINED steps in its turnaround, where the
+ * gain is that of the default step). FORCE: its stability function is
+ * negative for lambda dt > 2.41 (lambda the dashpot's relaxation rate), so
+ * across a stiff dashpot the force overshoots c v0, which the model's never
+ * exceeds (29 % at c = 1, dt = 1e-5). */
 enum { FINDING_ENERGY = 1, FINDING_EPS = 2, FINDING_FORCE = 4 };
 
 static int known_findings(int law, double c, double dt)
@@ -154,12 +156,10 @@ static int known_findings(int law, double c, double dt)
         double c, dt;
         int findings;
     } known[] = {
-        {2, 1e6, 1e-5, FINDING_ENERGY}, {2, 1e6, 1e-4, FINDING_ENERGY},
-        {2, 1e9, 1e-7, FINDING_ENERGY}, {2, 1e9, 1e-5, FINDING_ENERGY},
-        {2, 1e9, 1e-4, FINDING_ENERGY | FINDING_EPS},
-        {0, 1e-2, 1e-5, FINDING_FORCE}, {0, 1e-2, 1e-4, FINDING_FORCE}, {0, 1e-2, 1e-3, FINDING_FORCE},
-        {0, 1.0, 1e-5, FINDING_FORCE}, {0, 1.0, 1e-4, FINDING_FORCE}, {0, 1.0, 1e-3, FINDING_FORCE},
-        {1, 1e2, 1e-4, FINDING_FORCE}, {0, 1e2, 1e-3, FINDING_FORCE},
+        {2, 1e6, 1e-5, FINDING_ENERGY},
+        {2, 1e9, 1e-7, FINDING_ENERGY}, {2, 1e9, 1e-5, FINDING_ENERGY}, {2, 1e9, 1e-4, FINDING_ENERGY},
+        {2, 1e9, 1e-3, FINDING_ENERGY}, {2, 1e9, 1e-1, FINDING_ENERGY},
+        {0, 1e-2, 1e-5, FINDING_FORCE}, {0, 1.0, 1e-5, FINDING_FORCE},
     };
     size_t i;
     for (i = 0; i < sizeof known / sizeof known[0]; i++)
@@ -268,6 +268,26 @@ static void test_gap_and_gravity(void)
     CHECK(cm.s.impacts == 3, "3 impacts by t = %g s, got %" PRId64, cm.s.t, cm.s.impacts);
 }
 
+/* An advance that would take more than max_steps internal steps stops,
+ * returns NaN, says so, and leaves the state as it was; the same advance
+ * without the limit goes through (the h20 contact from t = 0: 13 161 steps
+ * of 1e-7 s, then one flight step). */
+static void test_step_limit(void)
+{
+    contact_params p;
+    contact_model cm;
+    double v0, m;
+    contact_default_params(&p);
+    contact_default_striker(&v0, &m);
+    contact_start(&cm, &p, v0, m);
+    cm.max_steps = 1000;
+    CHECK(isnan(contact_advance(&cm, 1.0)) && cm.exceeded, "an advance past max_steps fails and says why");
+    CHECK(cm.s.t == 0.0 && cm.s.steps == 0 && cm.s.x1 == 0.0 && cm.s.v == v0, "and changes nothing");
+    cm.max_steps = 13162;
+    CHECK(!isnan(contact_advance(&cm, 1.0)) && cm.s.impacts == 1 && cm.s.steps == 13162,
+          "within the limit it goes through: %lld steps", (long long)cm.s.steps);
+}
+
 int main(void)
 {
     test_hertz_constant();
@@ -278,6 +298,7 @@ int main(void)
     test_elastic_limit();
     test_stability();
     test_gap_and_gravity();
+    test_step_limit();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

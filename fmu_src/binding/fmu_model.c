@@ -41,6 +41,7 @@ struct fmu_model {
     int started;          /* past initialization: fixed parameters are frozen */
     int held;             /* a step stopped at an event: the discrete outputs show */
     int held_contact;     /* their values from before it until fm_update_discrete */
+    int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
     contact_model model;
     prediction next;
@@ -48,6 +49,10 @@ struct fmu_model {
 };
 
 #define PARAM(field) offsetof(fmu_model, params.field)
+
+/* The most internal steps one communication step may take: about a minute
+ * of CPU; beyond that a step is a mistake, not a wish. */
+#define MAX_STEPS 1000000000
 
 static const fmu_variable variable_list[] = {
     {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v)},
@@ -174,10 +179,13 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
         return FM_ERROR;
     if (var->causality == VAR_PARAMETER)
         return set_parameter(fm, var, &value, sizeof value);
-    /* Inputs: the scene-dependent rule (m > 0 in the drop test) waits for
-     * fm_start, since the scene may still change. */
+    /* Inputs: the rules that depend on the scene (m > 0 in the drop test)
+     * or on other parameters (a uniform grid's resolution) wait for
+     * fm_start, since those may still change. */
     if (contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
-                              vr == VR_m ? value : fm->m, why, sizeof why) != 0)
+                              vr == VR_m ? value : fm->m, why, sizeof why) != 0
+        || (fm->started && contact_check_resolution(&fm->params, vr == VR_v ? value : fm->v,
+                                                    vr == VR_m ? value : fm->m, why, sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     *(double *)((char *)fm + var->offset) = value;
     if (vr == VR_v)
@@ -307,14 +315,19 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     return FM_OK;
 }
 
-fm_status fm_start(fmu_model *fm, double t0)
+fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
     char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
-        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0)
+        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0
+        || contact_check_resolution(&fm->params, fm->v, fm->m, why, sizeof why) != 0
+        || (isfinite(t_stop)
+            && contact_check_history_span(&fm->params, fm->v, fm->m, t_stop - t0, 0, "stopTime - startTime", why,
+                                          sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_release(&fm->model);
     contact_start(&fm->model, &fm->params, fm->v, fm->m);
+    fm->model.max_steps = MAX_STEPS;
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
     fm->step_span = 0.0;
@@ -326,7 +339,8 @@ fm_status fm_start(fmu_model *fm, double t0)
     fm->next.valid = 0;
     fm->held = 0;
     fm->started = 1;
-    if (contact_unused_value(&fm->params, why, sizeof why))
+    if (contact_unused_value(&fm->params, why, sizeof why)
+        || contact_step_warning(&fm->params, fm->v, fm->m, why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     if (fm->coupling != COUPLING_GAUSS_SEIDEL && fm->params.scene == CONTACT_SCENE_DROP)
         return report(fm, FM_WARNING, "logStatusWarning",
@@ -399,20 +413,36 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
  * ignores never exceeds this fraction. */
 #define SAME_MOTION 1e-12
 
+/* Whether the master's velocity v, read as the coupling it names, is the
+ * proxy's own motion ending at v_end (SAME_MOTION). */
+static int same_motion(const fmu_model *fm, double v, double v_end)
+{
+    return fabs(v - v_end) <= SAME_MOTION * fmax(fmax(fabs(v), fabs(v_end)), fabs(fm->model.s.v_onset));
+}
+
 /* The velocity the step starts from. The master's v, except for a proxy
  * striker (driven scene, m > 0): with the Jacobi coupling less the impulse
  * owed (the striker has not yet received it), and its own end velocity
  * v_end when the master's agrees with it to rounding (SAME_MOTION). A
- * deterministic function of the state and the inputs, so that a memo of
- * the step (the prediction) may be dropped without changing a result. */
-static double start_velocity(const fmu_model *fm, double v_end)
+ * master that feeds the other force than `coupling` says (F_avg_next with
+ * coupling = 1, F_avg with 2) shows it where its v is the proxy's motion
+ * read as the other coupling: the proxy then follows its own motion too,
+ * and *other says so. A deterministic function of the state and the
+ * inputs, so that a memo of the step (the prediction) may be dropped
+ * without changing a result. */
+static double start_velocity(const fmu_model *fm, double v_end, int *other)
 {
-    double v = fm->v;
+    double jacobi, gauss_seidel, v;
+    *other = 0;
     if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->m > 0.0))
-        return v;
-    if (fm->coupling == COUPLING_JACOBI)
-        v -= fm->owed / fm->m;
-    return fabs(v - v_end) <= SAME_MOTION * fmax(fmax(fabs(v), fabs(v_end)), fabs(fm->model.s.v_onset)) ? v_end : v;
+        return fm->v;
+    jacobi = fm->v - fm->owed / fm->m;
+    gauss_seidel = fm->v;
+    v = fm->coupling == COUPLING_JACOBI ? jacobi : gauss_seidel;
+    if (same_motion(fm, v, v_end))
+        return v_end;
+    *other = same_motion(fm, fm->coupling == COUPLING_JACOBI ? gauss_seidel : jacobi, v_end);
+    return *other ? v_end : v;
 }
 
 /* The next step, of length H from the model's state as the last step left
@@ -428,7 +458,7 @@ static void predict(fmu_model *fm, double H)
      * predicted steps first, so that the copy never reallocates it. */
     if (contact_check_advance(cm, H, why, sizeof why) != 0
         || (contact_steps_uniformly(cm)
-            && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->p.dt_max + 0.5)) != 0))
+            && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->h_max + 0.5)) != 0))
         return;
     contact_copy(&p->model, cm);
     p->impulse = contact_advance(&p->model, H);
@@ -463,14 +493,15 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
                  announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
-    int from_prediction;
+    int from_prediction, other_coupling;
     *event = 0;
-    /* A refused step changes nothing, so the checks come first. About a
-     * minute of CPU: beyond that a step is a mistake, not a wish. */
-    if (H / fm->params.dt_max > 1e9)
+    /* A refused step changes nothing, so the checks come first: a uniform
+     * grid's steps are known in advance (the others' are counted as they
+     * are taken: MAX_STEPS, the model's max_steps). */
+    if (contact_steps_uniformly(cm) && H / cm->h_max > MAX_STEPS)
         return report(fm, FM_ERROR, "logStatusError",
-                      "DoStep: communicationStepSize = %g could take more than 1e9 internal steps "
-                      "of dt_max = %g; take shorter communication steps or a larger dt_max", H, fm->params.dt_max);
+                      "DoStep: communicationStepSize = %g takes more than 1e9 internal steps of dt_max = %g s on "
+                      "the uniform grid; take shorter communication steps or a larger dt_max", H, cm->h_max);
     if (H > 0.0 && contact_check_advance(cm, H, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
     fm_update_discrete(fm); /* a new step: the master has seen the last event */
@@ -485,7 +516,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     t_start = cm->s.t;
     v_end = cm->s.v;
-    contact_drive(cm, start_velocity(fm, v_end), fm->m, fm->v_slope);
+    contact_drive(cm, start_velocity(fm, v_end, &other_coupling), fm->m, fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
@@ -500,6 +531,11 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->step_start = step_start;
         fm->step_H = step_H;
         fm->next.valid = 0;
+        if (cm->exceeded)
+            return report(fm, FM_ERROR, "logStatusError",
+                          "DoStep: communicationStepSize = %g from t = %.17g s took more than 1e9 internal steps "
+                          "(about a minute of CPU) and was stopped; the state is kept at the start of the step "
+                          "(take shorter communication steps, a larger dt_max or tolerance > 0)", H, t);
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: the state became non-finite in [%.17g, %.17g] s; "
                       "it is kept at the start of the step", t, t + H);
@@ -559,6 +595,18 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->held_eps = before.eps;
     }
     report_events(fm, &before);
+    /* logged as a warning; the step itself went as it should */
+    if (other_coupling && !fm->coupling_warned) {
+        fm->coupling_warned = 1;
+        report(fm, FM_WARNING, "logStatusWarning",
+                      "coupling = %d, but the master's v at t = %.9g s follows %s: the proxy striker follows its "
+                      "own motion; set coupling = %d (with a force on the striker the FMU does not know, such as "
+                      "gravity in the master's striker, only the right coupling gives the right force)",
+                      fm->coupling, t,
+                      fm->coupling == COUPLING_JACOBI ? "F_avg fed after this FMU's step (Gauss-Seidel)"
+                                                      : "F_avg_next fed before it (Jacobi)",
+                      fm->coupling == COUPLING_JACOBI ? COUPLING_GAUSS_SEIDEL : COUPLING_JACOBI);
+    }
     return FM_OK;
 }
 
@@ -663,6 +711,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         if (!isfinite(serial_get_double(memory + 8 * i)))
             return report(fm, FM_ERROR, "logStatusError", "the FMU state's damper memory holds a non-finite value");
     contact_configure(&trial.model, &trial.params);
+    trial.model.max_steps = MAX_STEPS;
     if (nonfinite_output(&trial))
         return report(fm, FM_ERROR, "logStatusError", "the FMU state gives the output %s a non-finite value",
                       nonfinite_output(&trial)->name);

@@ -125,12 +125,13 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     instance *in = c;
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
     REQUIRE(INSTANTIATED, "fmi2SetupExperiment");
     if (!isfinite(startTime))
         return fail(in, "fmi2SetupExperiment: startTime = %g must be finite", startTime);
+    if (stopTimeDefined && !(stopTime >= startTime))
+        return fail(in, "fmi2SetupExperiment: stopTime = %g must not lie before startTime = %g", stopTime, startTime);
     in->base.start_time = startTime;
+    in->base.stop_time = stopTimeDefined ? stopTime : INFINITY;
     return fmi2OK;
 }
 
@@ -150,7 +151,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     instance *in = c;
     fm_status status;
     REQUIRE(INITIALIZATION_MODE, "fmi2ExitInitializationMode");
-    status = fm_start(in->base.fm, in->base.start_time);
+    status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
     if (status == FM_ERROR)
         return fmi2Error;
     in->base.state = STEP_COMPLETE;
@@ -171,6 +172,7 @@ fmi2Status fmi2Reset(fmi2Component c)
     REQUIRE(ANY_STATE, "fmi2Reset");
     fm_reset(in->base.fm);
     in->base.start_time = 0.0;
+    in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;
     return fmi2OK;
 }

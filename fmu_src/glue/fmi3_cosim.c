@@ -173,6 +173,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
         return fail(in, "fmi3EnterInitializationMode: stopTime = %g must not lie before startTime = %g", stopTime,
                     startTime);
     in->base.start_time = startTime;
+    in->base.stop_time = stopTimeDefined ? stopTime : INFINITY;
     in->base.state = INITIALIZATION_MODE;
     return fmi3OK;
 }
@@ -184,7 +185,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
     instance *in = c;
     fm_status status;
     REQUIRE(INITIALIZATION_MODE, "fmi3ExitInitializationMode");
-    status = fm_start(in->base.fm, in->base.start_time);
+    status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
     if (status == FM_ERROR)
         return fmi3Error;
     in->base.state = in->event_mode_used ? EVENT_MODE : STEP_MODE;
@@ -245,6 +246,7 @@ fmi3Status fmi3Reset(fmi3Instance c)
     REQUIRE(ANY_STATE, "fmi3Reset");
     fm_reset(in->base.fm);
     in->base.start_time = 0.0;
+    in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;
     return fmi3OK;
 }

@@ -50,6 +50,7 @@ void fi_probe(fmu_instance *in, const char *name, fi_sink sink)
     memset(in, 0, sizeof *in);
     in->name = (char *)(name ? name : FMU_MODEL_IDENTIFIER);
     in->sink = sink;
+    in->stop_time = INFINITY;
 }
 
 int fi_init(fmu_instance *in, const char *name, fi_sink sink, int logging_on, int state)

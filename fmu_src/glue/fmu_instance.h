@@ -26,6 +26,7 @@ struct fmu_instance {
     int logging_on;
     int category_on[FI_CATEGORIES];
     double start_time;
+    double stop_time; /* the experiment's, INFINITY when the master gives none */
     fmu_model *fm;
     fi_sink sink;
 };

@@ -34,9 +34,10 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value);
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value);
 fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value);
 
-/* End of initialization: checks what the model needs, starts it at t0.
+/* End of initialization: checks what the model needs, starts it at t0 for
+ * a run that the master means to end at t_stop (INFINITY: not said).
  * FM_WARNING: started, with a reported warning (a value without effect). */
-fm_status fm_start(fmu_model *fm, double t0);
+fm_status fm_start(fmu_model *fm, double t0, double t_stop);
 
 /* One communication step [t, t + H], and the model's time. The glue has
  * checked that H is finite and >= 0 and that t is the model's time up to

@@ -47,7 +47,7 @@ void contact_default_params(contact_params *p)
     p->c_alpha = 3e5;
     p->memory_tolerance = 1e-6;
     p->tolerance = 0.0;
-    p->dt_max = 1e-7;
+    p->dt_max = 0.0; /* fixed steps of CONTACT_DEFAULT_STEP; error-controlled ones uncapped */
     p->g = 0.0;
     p->gap0 = 0.0;
     p->law = CONTACT_LAW_G1;
@@ -129,9 +129,10 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
                       "infinite)");
     if (!invertible(p->c))
         return contact_reject(msg, len, "c", p->c, "the dashpot constant must be positive, finite and not denormal [N s/m]");
-    if (!invertible(p->dt_max))
+    if (!(p->dt_max == 0.0 || invertible(p->dt_max)))
         return contact_reject(msg, len, "dt_max", p->dt_max,
-                      "the largest internal step must be positive, finite and not denormal [s]");
+                      "the largest internal step must be positive, finite and not denormal, or 0 for fixed steps "
+                      "of 1e-7 s and no cap on error-controlled steps [s]");
     if (!isfinite(p->g))
         return contact_reject(msg, len, "g", p->g, "gravity must be finite [m/s^2]");
     if (!nonnegative(p->gap0))
@@ -264,6 +265,13 @@ static int tolerance_applies(const contact_params *p) { return p->tolerance > 0.
 
 int contact_error_controlled(const contact_params *p) { return tolerance_applies(p); }
 
+double contact_step_limit(const contact_params *p)
+{
+    if (p->dt_max > 0.0)
+        return p->dt_max;
+    return tolerance_applies(p) ? INFINITY : CONTACT_DEFAULT_STEP;
+}
+
 /* The shortest time over which the compressed memory's kernel holds its
  * tolerance. Fixed steps never go below dt_max. Error-controlled steps do,
  * far below it (the h20 impact's first steps at tolerance 1e-6 are about
@@ -281,7 +289,7 @@ int contact_error_controlled(const contact_params *p) { return tolerance_applies
  * steps' own error), up to 3.7e-8 off with delta = 1e-7 s. */
 static double memory_kernel_floor(const contact_params *p)
 {
-    return tolerance_applies(p) ? fmin(p->dt_max, CONTACT_MEMORY_FLOOR) : p->dt_max;
+    return tolerance_applies(p) ? fmin(contact_step_limit(p), CONTACT_MEMORY_FLOOR) : contact_step_limit(p);
 }
 
 static int unused_tolerance(const contact_params *p, char *msg, size_t len)
@@ -296,6 +304,91 @@ static int unused_tolerance(const contact_params *p, char *msg, size_t len)
 int contact_unused_value(const contact_params *p, char *msg, size_t len)
 {
     return unused_material(p, msg, len) || unused_damper_value(p, msg, len) || unused_tolerance(p, msg, len);
+}
+
+/* The spring constant k in use: given, or the Hertz constant derived. */
+static double spring_constant(const contact_params *p)
+{
+    return p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
+}
+
+/* The time the spring K x1^n takes to stop a striker (1/inv_m its mass)
+ * arriving at speed v, x_max / v with x_max = ((n + 1) v^2 / (2 K inv_m))^(1/(n+1))
+ * the elastic impact's largest indentation (MODEL.md §2), or where a load
+ * a > 0 presses the striker in, sqrt(x_a / a) with x_a = (a / (K inv_m))^(1/n)
+ * its indentation at rest under it: the shorter. A step much longer sees the
+ * striker stopped and thrown back within it, and the stages of a step that
+ * holds a whole impact give back more than it brought (eps = sqrt(2) as the
+ * mass vanishes). INFINITY without inertia (inv_m = 0) or either. */
+static double turnaround_time(double n, double K, double inv_m, double v, double a)
+{
+    double t = INFINITY;
+    if (!(inv_m > 0.0))
+        return t;
+    if (v > 0.0)
+        t = pow((n + 1.0) * v * v / (2.0 * K * inv_m), 1.0 / (n + 1.0)) / v;
+    if (a > 0.0)
+        t = fmin(t, sqrt(pow(a / (K * inv_m), 1.0 / n) / a));
+    return t;
+}
+
+/* Whether the parameters step on a uniform grid whatever happens. */
+static int uniform_grid(const contact_params *p)
+{
+    return p->scheme == CONTACT_SCHEME_CENTRAL
+           || (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_G1);
+}
+
+/* The turnaround time (above) of the first impact of a striker of mass m
+ * starting at v: the fastest, since the striker arrives at v (or falls
+ * through the gap under g) and every impact after loses speed. */
+static double first_turnaround(const contact_params *p, double v, double m)
+{
+    const double v2 = v > 0.0 || p->g > 0.0 ? v * v + 2.0 * p->g * p->gap0 : 0.0;
+    if (!(m > 0.0))
+        return INFINITY;
+    return turnaround_time(p->spring_exponent, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
+}
+
+/* "dt_max = 0 (fixed steps of 1e-07 s)" or "dt_max = 2e-07": the step as given. */
+static const char *shown_step(const contact_params *p, char text[64])
+{
+    char value[32];
+    if (p->dt_max > 0.0)
+        snprintf(text, 64, "dt_max = %s", shown(p->dt_max, value));
+    else
+        snprintf(text, 64, "dt_max = 0 (fixed steps of %s s)", shown(CONTACT_DEFAULT_STEP, value));
+    return text;
+}
+
+int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len)
+{
+    const double t = first_turnaround(p, v, m);
+    char text[3][64];
+    if (!uniform_grid(p) || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+        return 0;
+    snprintf(msg, len,
+             "%s is invalid with m = %s, v = %s: the spring stops the striker in %.3g s, which the %s uniform grid "
+             "resolves only in steps of at most %.3g s (%d per stop); lower dt_max to that, or take scheme = 1 and "
+             "memory = 2, whose steps shorten in contact",
+             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t,
+             p->scheme == CONTACT_SCHEME_CENTRAL ? "central scheme's" : "full G1 history's", t / CONTACT_RESOLUTION,
+             CONTACT_RESOLUTION);
+    return -1;
+}
+
+int contact_step_warning(const contact_params *p, double v, double m, char *msg, size_t len)
+{
+    const double t = first_turnaround(p, v, m);
+    char text[3][64];
+    if (uniform_grid(p) || tolerance_applies(p) || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+        return 0;
+    snprintf(msg, len,
+             "%s does not resolve the impact of m = %s at v = %s: the spring stops the striker in %.3g s, less "
+             "than %d steps; in contact the fixed steps are %.3g s instead (%d per stop)",
+             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t, CONTACT_RESOLUTION,
+             t / CONTACT_REFINED, CONTACT_REFINED);
+    return 1;
 }
 
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len)
@@ -339,11 +432,24 @@ static int full_history(const contact_model *cm)
     return springpot(cm) && cm->p.memory == CONTACT_MEMORY_G1;
 }
 
+/* The fixed step in the current contact: dt_max where it resolves the
+ * impact (CONTACT_RESOLUTION steps in its turnaround time) or the grid is
+ * uniform, else CONTACT_REFINED steps in that time: a step that does not
+ * resolve it is no one's choice, and a barely resolved one would show
+ * SDIRK2's gain of energy in nearly elastic impacts, which grows with the
+ * step like (h/t_c)^2.5 (docs/stability.md). Set where the onset speed or
+ * the inertia change. */
+static void resolve_contact(contact_model *cm)
+{
+    const double t = turnaround_time(cm->p.spring_exponent, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
+    cm->contact_step = uniform_grid(&cm->p) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
+}
+
 void contact_configure(contact_model *cm, const contact_params *p)
 {
     const double n = p->spring_exponent;
     cm->p = *p;
-    cm->k = p->k > 0.0 ? p->k : hertz_constant(p->R, p->E_i, p->nu_i, p->E_s, p->nu_s);
+    cm->k = spring_constant(p);
     cm->n_gamma = n == 1.5 ? GAMMA_5_2 : tgamma(n + 1.0);
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
@@ -351,6 +457,8 @@ void contact_configure(contact_model *cm, const contact_params *p)
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
     cm->error_controlled = tolerance_applies(p);
+    cm->h_max = contact_step_limit(p);
+    resolve_contact(cm);
     cm->series_limit = cm->error_controlled ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
     cm->peak_force_seen = -1.0;
     cm->peak_length = 0.0;
@@ -378,6 +486,7 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
     if (p->scene == CONTACT_SCENE_DROP) {
         cm->inv_m = 1.0 / m;
         cm->accel = p->g;
+        resolve_contact(cm);
     } else {
         contact_drive(cm, v0, m, 0.0);
     }
@@ -392,6 +501,7 @@ void contact_drive(contact_model *cm, double v, double m, double slope)
     cm->s.v = v;
     cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;
     cm->accel = m > 0.0 ? cm->p.g : slope;
+    resolve_contact(cm);
 }
 
 /* The spring force K x1^n at x1 > 0 (the Hertz sphere's n = 1.5 without pow). */
@@ -1019,6 +1129,7 @@ static void touch(contact_model *cm)
     cm->s.x1 = 0.0;
     cm->s.F = 0.0;
     begin_contact(&cm->s, cm->s.t, cm->s.v);
+    resolve_contact(cm);
 }
 
 /* Free flight for tau while the damper rests, exact (the step with no
@@ -1324,14 +1435,23 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
  * (law 2, tolerance 1e-7), 1e-4 of it, so that a movement of 1000
  * tolerances leaves an estimated error of 0.09 of the tolerance. */
 #define ONSET_MOVEMENT 1000.0
+
+/* An error-controlled step where nothing sets its scale (a contact that
+ * begins at rest): the cap, or the default fixed step where there is none;
+ * the control shrinks it as it must. */
+static double unscaled_step(const contact_model *cm)
+{
+    return isfinite(cm->h_max) ? cm->h_max : CONTACT_DEFAULT_STEP;
+}
+
 static double onset_step(const contact_model *cm)
 {
     const double n = cm->p.spring_exponent, v = cm->s.v, tol = ONSET_MOVEMENT * cm->p.tolerance;
     double Kv, h;
     if (!(v > 0.0))
-        return cm->p.dt_max;
+        return unscaled_step(cm);
     Kv = contact_spring_stiffness(cm, 1) * pow(v, n - 1.0);
-    h = fmin(cm->p.dt_max, pow(tol * cm->p.c / Kv, 1.0 / n));
+    h = fmin(cm->h_max, pow(tol * cm->p.c / Kv, 1.0 / n));
     if (cm->inv_m > 0.0)
         h = fmin(h, pow(tol / (cm->inv_m * Kv), 1.0 / (n + 1.0)));
     return h;
@@ -1353,7 +1473,7 @@ static int controlled_internal_step(contact_model *cm, double remaining, double 
     double h = s->n == 0 ? onset_step(cm) : s->h_next, tau = 0.0, J = 0.0, peak, h_next;
     int rejected, separates = 0;
     for (rejected = 0; rejected <= MAX_REJECTED_STEPS; rejected++) {
-        h = smaller(h, cm->p.dt_max);
+        h = smaller(h, cm->h_max);
         /* the last step lands on the interval's end (forgiving a few ulp) */
         tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
         J = esdirk_step(cm, s, tau, K, &trial);
@@ -1449,7 +1569,7 @@ static int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s;
     contact_history *hist = &cm->history;
-    const double h = cm->p.dt_max, alpha = cm->p.damper_order, c = cm->p.c_alpha;
+    const double h = cm->h_max, alpha = cm->p.damper_order, c = cm->p.c_alpha;
     const size_t j = (size_t)s->steps; /* the new grid point; s->steps counts this step already */
     const contact_state before = *s;
     /* BDF2 from the second step on, unless the master's new rate restarted it */
@@ -1569,12 +1689,12 @@ static int state_is_finite(const contact_model *cm)
 
 int contact_steps_uniformly(const contact_model *cm)
 {
-    return cm->p.scheme == CONTACT_SCHEME_CENTRAL || full_history(cm);
+    return uniform_grid(&cm->p);
 }
 
 int contact_check_advance(const contact_model *cm, double H, char *msg, size_t len)
 {
-    double steps = H / cm->p.dt_max, whole = floor(steps + 0.5);
+    double steps = H / cm->h_max, whole = floor(steps + 0.5);
     if (!full_history(cm))
         return 0;
     /* A sliver within the forgiveness of a whole step would be no step at
@@ -1583,17 +1703,41 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
         snprintf(msg, len,
                  "memory = 1 (the full G1 history) steps on a uniform grid of dt_max = %.17g s: an advance by "
                  "%.17g s is not a whole number (at least 1) of its steps (use memory = 2 for any step)",
-                 cm->p.dt_max, H);
+                 cm->h_max, H);
         return -1;
     }
     if ((double)cm->s.steps + whole > (double)CONTACT_G1_HISTORY_MAX) {
         snprintf(msg, len,
                  "memory = 1 (the full G1 history) keeps every step of the run, at most %d (t = %.17g s at "
                  "dt_max = %g s); use memory = 2, whose memory does not grow",
-                 CONTACT_G1_HISTORY_MAX, CONTACT_G1_HISTORY_MAX * cm->p.dt_max, cm->p.dt_max);
+                 CONTACT_G1_HISTORY_MAX, CONTACT_G1_HISTORY_MAX * cm->h_max, cm->h_max);
         return -1;
     }
     return 0;
+}
+
+int contact_check_history_span(const contact_params *p, double v, double m, double span, int until_first_separation,
+                               const char *name, char *msg, size_t len)
+{
+    const double h = contact_step_limit(p), reach = CONTACT_G1_HISTORY_MAX * h;
+    double arrival;
+    char text[2][32];
+    if (p->damper != CONTACT_DAMPER_SPRINGPOT || p->memory != CONTACT_MEMORY_G1 || !(span > reach))
+        return 0;
+    if (until_first_separation && m > 0.0) {
+        /* Such a run lasts as long as the striker's flight to the specimen
+         * (it stops at once when the striker never gets there) and one
+         * contact, whose length is not known in advance. */
+        arrival = flight_onset(-p->gap0, v, p->g, span);
+        if (arrival < 0.0 ? !(p->g > 0.0) : arrival <= reach)
+            return 0;
+    }
+    snprintf(msg, len,
+             "memory = 1 is invalid with %s = %s: the full G1 history keeps every step of dt_max = %s s, at most "
+             "%d (to t = %.9g s), and this run may go on for longer; use memory = 2 (any length), a %s within "
+             "that, or a larger dt_max",
+             name, shown(span, text[0]), shown(h, text[1]), CONTACT_G1_HISTORY_MAX, reach, name);
+    return -1;
 }
 
 /* The recovery's steps as a fraction of the time since separation. With
@@ -1604,7 +1748,7 @@ static double recovery_fraction(const contact_model *cm)
     const contact_state *s = &cm->s;
     if (cm->error_controlled)
         return fmin(1.0 / 16.0, sqrt(cm->p.tolerance / 1.2e-6) / 16.0);
-    return s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->p.dt_max / s->t_contact) : 1.0 / 16.0;
+    return s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->h_max / s->t_contact) : 1.0 / 16.0;
 }
 
 /* The next step out of contact while a springpot's memory relaxes: at
@@ -1616,7 +1760,7 @@ static double recovery_step(const contact_model *cm, double remaining)
     const contact_state *s = &cm->s;
     const double since = s->impacts > 0 ? s->t - (s->t_onset + s->t_contact) : 0.0;
     const double f = recovery_fraction(cm);
-    const double least = cm->error_controlled && s->h_next > 0.0 ? f * s->h_next : cm->p.dt_max;
+    const double least = !cm->error_controlled ? cm->h_max : s->h_next > 0.0 ? f * s->h_next : unscaled_step(cm);
     return fmin(remaining, fmax(least, f * since));
 }
 
@@ -1628,15 +1772,20 @@ double contact_advance(contact_model *cm, double H)
 double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
 {
     const contact_state start = cm->s;
+    const int64_t allowed = cm->max_steps > 0 ? start.steps + cm->max_steps : INT64_MAX;
     double phi_start[CONTACT_MAX_MODES];
     double remaining = H, impulse = 0.0;
-    int stopped = 0, failed = 0, uniform = contact_steps_uniformly(cm);
+    int stopped = 0, failed = 0, exceeded = 0, uniform = contact_steps_uniformly(cm);
     if (!(H > 0.0))
         return 0.0;
     if (compressed_memory(cm))
         memcpy(phi_start, cm->modes.phi, cm->modes.modes * sizeof *phi_start);
     while (remaining > 0.0 && !stopped && !failed) {
-        double n, h, i;
+        double n, h, i, steps;
+        if (cm->s.steps >= allowed) {
+            failed = exceeded = 1;
+            break;
+        }
         if (!cm->s.in_contact && !uniform) {
             /* Free flight is exact at any length while the damper rests: one
              * step to the onset, or over the whole rest when the striker does
@@ -1668,15 +1817,17 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
             remaining = advanced < remaining ? remaining - advanced : 0.0;
             continue;
         }
-        /* In contact: equal steps of at most dt_max over the rest, rounding
-         * n up but forgiving the last few ulp of the step and of the clock
-         * (H = n dt_max gives n steps, not n + 1 with a sliver, also when a
-         * master computes H as t_next - t, which errs by an ulp of t), until
-         * the contact ends. */
-        n = fmax(1.0, ceil((remaining - 4.0 * DBL_EPSILON * fabs(cm->s.t + remaining)) / cm->p.dt_max *
+        /* In contact: equal steps of at most dt_max (or what resolves the
+         * impact) over the rest, rounding n up but forgiving the last few ulp
+         * of the step and of the clock (H = n dt_max gives n steps, not n + 1
+         * with a sliver, also when a master computes H as t_next - t, which
+         * errs by an ulp of t), until the contact ends or the steps allowed
+         * run out. */
+        n = fmax(1.0, ceil((remaining - 4.0 * DBL_EPSILON * fabs(cm->s.t + remaining)) / cm->contact_step *
                            (1.0 - 1e-12)));
         h = remaining / n;
-        for (i = 0; i < n && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
+        steps = smaller(n, (double)(allowed - cm->s.steps));
+        for (i = 0; i < steps && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
             int status = internal_step(cm, h, &impulse, stop_at);
             failed = status < 0;
             stopped = status > 0;
@@ -1686,6 +1837,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
     /* A non-finite value stays non-finite through the steps that follow
      * (and bounds their event searches), so one check at the end suffices. */
     if (failed || !state_is_finite(cm)) {
+        cm->exceeded = exceeded;
         cm->s = start;
         if (compressed_memory(cm))
             memcpy(cm->modes.phi, phi_start, cm->modes.modes * sizeof *phi_start);
@@ -1709,6 +1861,13 @@ int contact_never_returns(const contact_model *cm)
     if (s->v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
         return a < 0.0 && !(s->x1 + 0.5 * s->v * s->v / -a > 0.0);
     return 1;
+}
+
+int contact_rests(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    return s->in_contact && !springpot(cm) && cm->accel == 0.0 && s->F <= DBL_EPSILON * s->F_peak_contact
+           && fabs(s->v) <= DBL_EPSILON * fabs(s->v_onset);
 }
 
 double contact_elastic_indentation(const contact_model *cm)

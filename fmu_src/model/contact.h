@@ -53,6 +53,17 @@ enum contact_memory {
 #define CONTACT_MEMORY_SPAN 1e3
 #define CONTACT_MEMORY_FLOOR 1e-9
 
+/* The fixed step of dt_max = 0, the default: the paper's h20 step [s]. */
+#define CONTACT_DEFAULT_STEP 1e-7
+
+/* A fixed step resolves an impact when at least this many of them fit in
+ * the time the spring takes to stop the striker (contact.c,
+ * turnaround_time); a contact that dt_max does not resolve is stepped at
+ * CONTACT_REFINED steps in that time instead: about the resolution the
+ * default step gives the paper's h20 impact. */
+#define CONTACT_RESOLUTION 6
+#define CONTACT_REFINED 4000
+
 /* The full G1 history keeps x2 at every step of the run: at most this many
  * steps (8 MiB of history, and as much for the G1 weights). */
 #define CONTACT_G1_HISTORY_MAX 1048576
@@ -73,7 +84,8 @@ typedef struct {
     double c_alpha;      /* springpot constant [N s^alpha/m] */
     double memory_tolerance; /* relative error of the compressed memory's kernel */
     double tolerance;    /* relative error per internal step; 0: fixed steps of dt_max */
-    double dt_max;       /* largest internal step [s] */
+    double dt_max;       /* largest internal step [s]; 0: fixed steps of CONTACT_DEFAULT_STEP, and no
+                            cap on error-controlled steps (contact_step_limit) */
     double g;            /* acceleration of the model's striker towards the specimen [m/s^2] */
     double gap0;         /* gap between striker and specimen at the start [m] */
     int law;             /* enum contact_law */
@@ -164,6 +176,10 @@ typedef struct {
     contact_poll poll;        /* NULL (contact_start), or the caller's */
     void *poll_ctx;
     contact_state s;
+    double h_max;           /* contact_step_limit(&p) */
+    double contact_step;    /* the fixed step in the current contact: h_max, or shorter to resolve it */
+    int64_t max_steps;      /* the most internal steps one advance may take; 0: no limit */
+    int exceeded;           /* set by an advance that fails: whether it stopped at max_steps */
     contact_modes modes;      /* a springpot's compressed memory */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
@@ -198,14 +214,33 @@ int contact_unused_value(const contact_params *p, char *msg, size_t len);
  * it applies), 0 when it takes fixed steps of dt_max. */
 int contact_error_controlled(const contact_params *p);
 
+/* The largest internal step of these parameters [s]: dt_max; for dt_max = 0
+ * the fixed step CONTACT_DEFAULT_STEP, or INFINITY (no cap) where the steps
+ * are error-controlled. Fixed steps are of this length (shorter only to
+ * land on an interval's end or to resolve a contact, contact_advance). */
+double contact_step_limit(const contact_params *p);
+
 /* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
  * `scene` with the parameters *p (which must have passed their check): a
  * run must also be able to hold its energies and powers in doubles. */
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len);
 
+/* Whether the uniform grids (the central scheme, the full G1 history),
+ * whose steps cannot shorten in contact, resolve the first impact of a
+ * striker of mass m starting at v (the fastest: CONTACT_RESOLUTION steps
+ * while the spring stops the striker). 0, or -1 and a message naming
+ * dt_max, its value and the rule. */
+int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len);
+
+/* A warning where fixed steps of dt_max do not resolve that impact and are
+ * refined in contact (contact_advance): 1 and the message, or 0. */
+int contact_step_warning(const contact_params *p, double v, double m, char *msg, size_t len);
+
 /* Takes the parameters and the constants derived from them (k, 1/c, a fixed
- * stiffness, the compressed memory's kernel), leaving the state and the
- * memory's values alone: for a state restored from elsewhere. */
+ * stiffness, the compressed memory's kernel, the fixed step of a contact in
+ * progress: from the state, inv_m and accel, which must be set), leaving
+ * the state and the memory's values alone: for a state restored from
+ * elsewhere. */
 void contact_configure(contact_model *cm, const contact_params *p);
 
 /* Starts at t = 0 with the striker at the gap gap0 moving at v0 (towards the
@@ -243,6 +278,15 @@ void contact_memory_set(contact_model *cm, size_t i, double value);
  * CONTACT_G1_HISTORY_MAX steps. 0, or -1 and a message. */
 int contact_check_advance(const contact_model *cm, double H, char *msg, size_t len);
 
+/* Whether the full G1 history (memory = 1) holds a run from the start that
+ * may go on for `span` [s], named `name` (t_end, stopTime) in the message:
+ * at most CONTACT_G1_HISTORY_MAX steps of dt_max. With
+ * until_first_separation the run stops at its first separation (a
+ * striker of mass m > 0 starting at v): only its flight to the specimen
+ * must fit then. 0 (also for the other memories), or -1 and a message. */
+int contact_check_history_span(const contact_params *p, double v, double m, double span, int until_first_separation,
+                               const char *name, char *msg, size_t len);
+
 /* Whether the model steps on a uniform grid of dt_max whatever happens (the
  * central scheme, the full G1 history): a caller advancing step by step
  * should then advance by dt_max. */
@@ -263,13 +307,17 @@ void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, dou
 double contact_damper_rate(const contact_model *cm);
 
 /* Advances the model by H >= 0 in equal internal steps of at most dt_max that
- * land exactly on t + H, locating contact onset and separation within a step;
+ * land exactly on t + H (in contact, fixed steps are shorter where dt_max
+ * would not resolve the impact: CONTACT_REFINED), locating contact onset
+ * and separation within a step;
  * free flight is one exact step (while a springpot recovers, steps growing
  * with the time since separation). The full G1 history takes steps of
  * dt_max, and onset and separation fall on them (contact_check_advance
  * first). Returns the impulse of the contact force
  * over the interval [N s]; on a numerical failure (a non-finite state)
- * returns NaN and leaves the state as it was at the start of the advance. */
+ * returns NaN and leaves the state as it was at the start of the advance;
+ * the same when it would take more than cm->max_steps internal steps
+ * (cm->exceeded, set by a failed advance, says which). */
 double contact_advance(contact_model *cm, double H);
 
 /* The same, but it stops right after the first event of the mask stop_at
@@ -281,6 +329,14 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at);
  * back; a recovering springpot's dent, x2 >= 0, only when the striker is
  * clear of the undeformed surface): nothing it feels changes from then on. */
 int contact_never_returns(const contact_model *cm);
+
+/* Whether the striker has come to rest in contact for good: nothing loads
+ * it (no acceleration apart from the contact force), the damper is the
+ * dashpot (a springpot's memory would still move it), and the force and the
+ * striker's speed have fallen below the rounding of the contact's peak
+ * force and onset speed. An overdamped contact creeps to rest this way and
+ * never separates; nothing it reports changes any more. */
+int contact_rests(const contact_model *cm);
 
 /* Outputs derived from the state. */
 double contact_elastic_indentation(const contact_model *cm);  /* x1 >= 0 */

@@ -14,7 +14,7 @@ SUFFIX = {"win32": ".dll", "darwin": ".dylib"}.get(sys.platform, ".so")
 PREFIX = "" if sys.platform == "win32" else "lib"
 
 FC_OK, FC_EINVAL, FC_EFAIL, FC_ENOMEM, FC_ESTOPPED = 0, 1, 2, 3, 4
-STOPS = {1: "impacts", 2: "t_end", 3: "receding"}
+STOPS = {1: "impacts", 2: "t_end", 3: "receding", 4: "resting"}
 NO_ROWS, EVERY_STEP, DEFAULT_ROWS = -1.0, 0.0, -2.0
 COLUMNS = ("t", "F", "x", "x1", "x2", "v", "E_diss")
 MESSAGE_SIZE = 512
@@ -57,6 +57,7 @@ def _load():
     lib.fc_drop_velocity.restype = ctypes.c_double
     lib.fc_drop_velocity.argtypes = [ctypes.c_double]
     lib.fc_default_output_interval.restype = ctypes.c_double
+    lib.fc_step_limit.restype = ctypes.c_double
     return lib
 
 

@@ -78,6 +78,13 @@ def defaults():
     return {name: getattr(p, name) for name in NAMES}
 
 
+def step_limit(**params):
+    """The largest internal step of these parameters [s]: dt_max, or for
+    dt_max = 0 (the default) the fixed step of 1e-7 s, or inf where
+    error-controlled steps have no cap."""
+    return _lib.LIB.fc_step_limit(ctypes.byref(_params(**params)))
+
+
 def drop_velocity(height):
     """The impact velocity sqrt(2 g h) of a drop from height h [m], g = 9.81 m/s^2."""
     return _lib.LIB.fc_drop_velocity(float(height))

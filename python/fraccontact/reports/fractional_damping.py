@@ -381,7 +381,7 @@ def kernels():
         for tol in TOLERANCES:
             a, b, eta = model.memory_kernel(damper_order=alpha, memory_tolerance=tol)
             rows.append(dict(alpha=alpha, tol=tol, M=len(a), eta=eta,
-                             error=kernel_error(a, b, alpha, H20["dt_max"], SPAN)))
+                             error=kernel_error(a, b, alpha, model.step_limit(), SPAN)))
     broken = []
     for tol in TOLERANCES[:4]:
         bad = [a for a in np.arange(0.002, 0.2, 0.002)
@@ -618,7 +618,7 @@ def order(errors, steps):
 def section_curves(series, omega, one):
     lines = ["## 1. Force curves and hysteresis loops", "",
              f"The h20 drop (m = {M:g} kg, v0 = {V0:.4g} m/s, k = {H20['k']:.4g} N/m^1.5, n = 1.5, dt_max = "
-             f"{H20['dt_max']:g} s, compressed memory). To make the orders comparable each springpot is given "
+             f"{model.step_limit():g} s, compressed memory). To make the orders comparable each springpot is given "
              "c_alpha = c omega^(1-alpha): its dynamic stiffness c_alpha omega^alpha equals the dashpot's c omega at "
              f"the impact's frequency omega = pi / t_contact = {omega:.0f} rad/s (the dashpot's t_contact), "
              f"c = {C:g} N s/m. The loss angle is alpha pi / 2 at every frequency, so at equal stiffness a lower alpha "

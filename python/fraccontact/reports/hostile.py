@@ -373,7 +373,7 @@ def last(r):
 def internal_step(case):
     """The FMU's internal step in contact: the communication step or
     dt_max, whichever is shorter."""
-    return min(params(case)["dt_max"], max(arg for kind, arg in case["steps"] if kind == "step"))
+    return min(model.step_limit(**params(case)), max(arg for kind, arg in case["steps"] if kind == "step"))
 
 
 def drop_identities(j, case, r):

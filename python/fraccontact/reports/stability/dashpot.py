@@ -12,7 +12,7 @@ from ... import hertz, model, solver
 from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 
 # The paper's h20 test; a case changes some of these (v0 is the library's v, dt its dt_max).
-BASE = dict(c=H20["c"], E_s=H20["E_s"], v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g1_nodes=0, gap0=0.0, g=0.0,
+BASE = dict(c=H20["c"], E_s=H20["E_s"], v0=H20["v"], m=H20["m"], dt=model.step_limit(), g1_nodes=0, gap0=0.0, g=0.0,
             impacts=1)
 QUANTITIES = ("F_peak", "eps", "t_contact", "x2", "E_diss", "v")
 # Reference comparison, |error| <= C2 (dt/T)^2 [+ D1 dt/T for the G1 law

@@ -24,7 +24,7 @@ from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 OMEGA = 2400.0  # [rad/s] the h20 impact's frequency pi/t_c (MODEL.md §7)
 MEMORY1_STEPS = 50000
 X_REF = hertz.indentation(H20["k"], H20["m"], H20["v"])  # the h20 Hertz impact's x_max
-BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=H20["dt_max"], g=0.0, gap0=0.0, impacts=1,
+BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=model.step_limit(), g=0.0, gap0=0.0, impacts=1,
             t_end=0.0, tolerance=H20["memory_tolerance"], memory1_steps=MEMORY1_STEPS)
 QUANTITIES = ("F_peak", "eps", "t_contact", "E_diss", "v_onset", "x2", "v", "E_end")
 # Compared at t_end (when both runs stopped there): an error that may grow
