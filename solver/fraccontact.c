@@ -252,8 +252,9 @@ static double least_span(const fc_params *p, double *in_contact)
     return onset + *in_contact;
 }
 
-/* The least number of internal steps of the run: steps of at most dt_max
- * over its contacts, or over the whole span on a uniform grid. */
+/* The least number of internal steps of the run: steps of at most the
+ * step limit (dt_max, its default, or none under error control) over its
+ * contacts, or over the whole span on a uniform grid. */
 static double least_steps(const fc_params *p)
 {
     contact_params q;
@@ -261,16 +262,16 @@ static double least_steps(const fc_params *p)
     double in_contact, span = least_span(p, &in_contact);
     fc_model_params(p, &q);
     contact_start(&cm, &q, p->v, p->m);
-    return (contact_steps_uniformly(&cm) ? span : in_contact) / p->dt_max;
+    return (contact_steps_uniformly(&cm) ? span : in_contact) / contact_step_limit(&q);
 }
 
 static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
 {
     char rule[256];
     snprintf(rule, sizeof rule,
-             "the run would take at least %.3g internal steps of at most dt_max, more than %.0e; raise dt_max, or "
+             "the run would take at least %.3g internal steps of at most %.3g s, more than %.0e; raise dt_max, or "
              "lower t_end or impacts",
-             steps, FC_STEPS_MAX);
+             steps, fc_step_limit(p), FC_STEPS_MAX);
     contact_reject(msg, len, "dt_max", p->dt_max, rule);
     return FC_EINVAL;
 }

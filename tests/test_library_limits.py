@@ -154,7 +154,8 @@ def test_a_run_beyond_the_steps_limit_is_refused_up_front(values, steps):
     r = fc_run_in_child(-1.0, **values)
     assert r["status"] == FC_EINVAL and r["steps"] == 0, r
     why = r["why"]
-    assert why.startswith(f"dt_max = {values.get('dt_max', 1e-7):g} is invalid: the run would take at least "), why
+    assert why.startswith(f"dt_max = {values.get('dt_max', 0):g} is invalid: the run would take at least "), why
+    assert f"internal steps of at most {values.get('dt_max', 1e-7):.3g} s," in why, why
     assert f"more than {STEPS_MAX:.0e}" in why and "\n" not in why, why
     assert float(why.split("at least ")[1].split(" internal")[0]) == pytest.approx(steps, rel=0.01, abs=0), why
 

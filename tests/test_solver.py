@@ -73,7 +73,7 @@ def test_json_names_the_method_that_ran(args, method):
 
 @pytest.mark.parametrize("args, says", [
     (["--c", "-1"], "c = -1"), (["--c", "abc"], "--c 'abc'"), (["--bogus", "1"], "--bogus"),
-    (["--law", "foo"], "--law 'foo'"), (["--dt-max", "0"], "dt_max = 0"), (["--m", "0"], "m = 0"),
+    (["--law", "foo"], "--law 'foo'"), (["--dt-max", "-1"], "dt_max = -1"), (["--m", "0"], "m = 0"),
     (["--height", "-1e-3"], "--height"), (["--t-end", "0"], "--t-end"), (["--json=1"], "--json"),
     (["--k"], "needs a value"), (["--g1-nodes", "2.5"], "--g1-nodes"), (["--scheme", "rk4"], "--scheme")])
 def test_bad_options_exit_2_with_a_clear_message(args, says):
@@ -259,7 +259,7 @@ def test_a_negative_or_nonfinite_height_is_refused(height):
     (["--impacts", ""], "--impacts '' (empty)"), (["--height", "nan"], "--height 'nan'"),
     (["--t-end", "0"], "--t-end '0'"), (["--rtol", "0"], "--rtol '0'"), (["--repeat", "0"], "--repeat '0'"),
     (["--output-interval", "-1"], "--output-interval '-1'"), (["--c", "-1e0"], "--c '-1e0'"),
-    (["--dt-max=0.0"], "--dt-max '0.0'"), (["--m", "-0"], "--m '-0'"), (["--E-s", "-2e9"], "--E-s '-2e9'"),
+    (["--dt-max=-1e-9"], "--dt-max '-1e-9'"), (["--m", "-0"], "--m '-0'"), (["--E-s", "-2e9"], "--E-s '-2e9'"),
     (["--law", "9"], "--law '9'"), (["--impacts", "0"], "--impacts '0'")])
 def test_every_message_names_the_option_and_the_value_as_typed(args, says):
     done = solve(*args, check=False)

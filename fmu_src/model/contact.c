@@ -325,10 +325,12 @@ static double turnaround_time(double n, double K, double inv_m, double v, double
     double t = INFINITY;
     if (!(inv_m > 0.0))
         return t;
+    /* Power by power, so that no product of the inputs under- or overflows
+     * (v^2 of a denormal v is 0, which made the step 0). */
     if (v > 0.0)
-        t = pow((n + 1.0) * v * v / (2.0 * K * inv_m), 1.0 / (n + 1.0)) / v;
+        t = pow((n + 1.0) / (2.0 * K), 1.0 / (n + 1.0)) * pow(inv_m, -1.0 / (n + 1.0)) * pow(v, (1.0 - n) / (n + 1.0));
     if (a > 0.0)
-        t = fmin(t, sqrt(pow(a / (K * inv_m), 1.0 / n) / a));
+        t = fmin(t, sqrt(pow(a, 1.0 / n - 1.0) * pow(K, -1.0 / n) * pow(inv_m, -1.0 / n)));
     return t;
 }
 
