@@ -341,7 +341,16 @@ static int uniform_grid(const contact_params *p)
            || (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_G1);
 }
 
-/* The turnaround time (above) of the first impact of a striker of mass m
+/* The turnaround time (above), or m / c where that is longer: while the
+ * striker loads the specimen, the series dashpot holds the force below c v,
+ * so no striker stops faster (a rigid spring leaves the dashpot alone). */
+static double stopping_time(const contact_params *p, double K, double inv_m, double v, double a)
+{
+    const double t = turnaround_time(p->spring_exponent, K, inv_m, v, a);
+    return p->damper == CONTACT_DAMPER_DASHPOT ? fmax(t, 1.0 / (p->c * inv_m)) : t;
+}
+
+/* The stopping time (above) of the first impact of a striker of mass m
  * starting at v: the fastest, since the striker arrives at v (or falls
  * through the gap under g) and every impact after loses speed. */
 static double first_turnaround(const contact_params *p, double v, double m)
@@ -349,7 +358,7 @@ static double first_turnaround(const contact_params *p, double v, double m)
     const double v2 = v > 0.0 || p->g > 0.0 ? v * v + 2.0 * p->g * p->gap0 : 0.0;
     if (!(m > 0.0))
         return INFINITY;
-    return turnaround_time(p->spring_exponent, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
+    return stopping_time(p, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
 }
 
 /* "dt_max = 0 (fixed steps of 1e-07 s)" or "dt_max = 2e-07": the step as given. */
@@ -443,7 +452,7 @@ static int full_history(const contact_model *cm)
  * the inertia change. */
 static void resolve_contact(contact_model *cm)
 {
-    const double t = turnaround_time(cm->p.spring_exponent, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
+    const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
     cm->contact_step = uniform_grid(&cm->p) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
 }
 
