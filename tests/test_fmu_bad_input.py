@@ -40,7 +40,7 @@ def test_non_finite_reals_are_rejected(slave, name, value, shown):
 
 
 @pytest.mark.parametrize("name, value", [
-    ("c", 0.0), ("c", -6080.0), ("k", -1.0), ("R", 0.0), ("R", -1e-3), ("dt_max", 0.0),
+    ("c", 0.0), ("c", -6080.0), ("k", -1.0), ("R", 0.0), ("R", -1e-3), ("dt_max", -1e-7),
     ("dt_max", -1e-7), ("m", -0.7437), ("E_i", 0.0), ("E_s", -1.0), ("nu_i", 0.7), ("nu_s", -1.5),
     ("gap0", -1e-3), ("law", 0), ("law", 4), ("scene", 0), ("scene", 3), ("g1_nodes", -5)])
 def test_out_of_range_values_are_rejected(slave, name, value):

@@ -97,7 +97,7 @@ def test_simulate_gives_the_run_and_rows_on_its_grid():
 
 
 @pytest.mark.parametrize("params, says", [
-    (dict(c=-1.0), "c = -1 is invalid"), (dict(dt_max=0.0), "dt_max = 0 is invalid"),
+    (dict(c=-1.0), "c = -1 is invalid"), (dict(dt_max=-1e-7), "dt_max = -1e-07 is invalid"),
     (dict(law="rk4"), "law = 'rk4' is invalid"), (dict(impacts=0), "impacts = 0 is invalid"),
     (dict(height=-1.0), "height = -1.0 is invalid"), (dict(v=1e300), "v = 1e+300 is invalid")])
 def test_bad_values_raise_the_librarys_message(params, says):

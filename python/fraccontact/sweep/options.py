@@ -4,11 +4,11 @@ partitions' columns); everything refused here is refused before a cluster
 starts or anything is written."""
 
 import argparse
+import importlib
 import math
 import os
 import pathlib
 import shutil
-import sys
 from fractions import Fraction
 
 import numpy as np
@@ -296,7 +296,7 @@ def writable_folder(path):
 
 
 def arguments(argv, prog):
-    parser = argparse.ArgumentParser(prog=prog, description=sys.modules[__package__].__doc__,
+    parser = argparse.ArgumentParser(prog=prog, description=importlib.import_module(__package__).__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=VALUES",
                         help=f"NAME=a:b:step or NAME=v1,v2,... (repeat for a grid; default height={DEFAULT_HEIGHTS}); "
