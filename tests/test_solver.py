@@ -358,7 +358,8 @@ def solve_limited(*args, seconds=30, cwd=None):
     """The solver with at most 2 GB of address space and `seconds` of time:
     code that would take the machine's memory or hours fails instead."""
     def limit():
-        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+        if os.environ.get("FRACCONTACT_SANITIZED") != "1":  # ASan reserves its shadow memory beyond any such limit
+            resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
 
     try:
         return subprocess.run([SOLVE, *map(str, args)], capture_output=True, text=True, timeout=seconds,
