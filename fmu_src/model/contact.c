@@ -341,13 +341,23 @@ static int uniform_grid(const contact_params *p)
            || (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_G1);
 }
 
-/* The turnaround time (above), or m / c where that is longer: while the
- * striker loads the specimen, the series dashpot holds the force below c v,
- * so no striker stops faster (a rigid spring leaves the dashpot alone). */
+/* The time the damper alone takes to stop the striker: m / c for the
+ * dashpot, (m / c_alpha)^(1/(2 - alpha)) for the springpot (the time scale
+ * of m x'' = -c_alpha D^alpha x). */
+static double damper_time(const contact_params *p, double inv_m)
+{
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT)
+        return pow(p->c_alpha * inv_m, -1.0 / (2.0 - p->damper_order));
+    return 1.0 / (p->c * inv_m);
+}
+
+/* The turnaround time (above), or the damper's time where that is longer:
+ * while the striker loads the specimen, the series damper bounds the force
+ * (below c v for the dashpot), so no striker stops faster (a rigid spring
+ * leaves the damper alone). */
 static double stopping_time(const contact_params *p, double K, double inv_m, double v, double a)
 {
-    const double t = turnaround_time(p->spring_exponent, K, inv_m, v, a);
-    return p->damper == CONTACT_DAMPER_DASHPOT ? fmax(t, 1.0 / (p->c * inv_m)) : t;
+    return fmax(turnaround_time(p->spring_exponent, K, inv_m, v, a), damper_time(p, inv_m));
 }
 
 /* The stopping time (above) of the first impact of a striker of mass m
