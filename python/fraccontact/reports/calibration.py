@@ -324,6 +324,7 @@ def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     parser.add_argument("--impacts", type=int, default=4000, help="impacts for the throughput runs (default 4000)")
     args = reports.parse(parser, argv)
+    reports.pyplot()  # before the minutes of sweeps: a missing matplotlib is said at once
     with tempfile.TemporaryDirectory() as work:
         write_report(args, pathlib.Path(work))
 
