@@ -87,7 +87,7 @@ def test_alpha_1_is_the_dashpot_as_the_readme_says(law):
     every communication point of the impact; x2, E_diss within the README's
     rounding bound; over nine bounces under gravity eps, x2, E_diss within
     its second bound. Independent of either damper's code: the two runs are
-    different arithmetic of one model, and MODEL.md §7's springpot at
+    different arithmetic of one model, and docs/model.md §5's springpot at
     alpha = 1 is the dashpot."""
     (first,) = claim(r"`x2` and `E_diss` differ by rounding, within (\S+) over an impact")
     stop, impacts, later = claim(r"bouncing under gravity \((\S+) s, (\w+) impacts\), eps, x2 and E_diss stay within (\S+) of")

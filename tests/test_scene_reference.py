@@ -15,7 +15,7 @@ from fraccontact import crash, hertz
 from fraccontact.scenes import bumper, headform, parameters
 from fraccontact.scenes.chain import GROUND, Chain, Contact, Link
 
-K, C = 329.9e6, 6080.0          # the paper's h20 polypropylene (MODEL.md §6)
+K, C = 329.9e6, 6080.0          # the paper's h20 polypropylene (docs/model.md §1)
 
 
 def two_free_bodies(m1, m2, v):

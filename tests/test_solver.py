@@ -493,7 +493,7 @@ def test_the_reference_warns_that_the_models_steps_change_nothing(option, value)
 def test_the_reference_says_which_law_it_solves():
     """Without --law the reference solves the G1 law's continuous limit, the
     Hertz law, and says so; the same figures as --law hertz to the bit. With
-    a fixed N it solves the G1 law on N intervals (MODEL.md §4): the
+    a fixed N it solves the G1 law on N intervals (docs/model.md §4): the
     model's figures at a fine step, not the Hertz law's."""
     assert solve("--reference").stdout.startswith("reference, law hertz,")
     hertz = without_timing(solve_json("--reference", "--law", "hertz"))
