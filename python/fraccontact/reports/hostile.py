@@ -160,7 +160,7 @@ def same(a, b):
 
 def run_case_in(s, case):
     """Runs one case on s, a fresh instance not yet in initialization mode
-    (tests/fmu_driver.Slave). Returns what was observed: the verdict reached,
+    (tests/fmu_driver.py's Slave). Returns what was observed: the verdict reached,
     the message, the outputs after every communication step (trace), the
     warnings, and after a refusal whether the instance stayed usable."""
     from fmpy.fmi1 import FMICallException
