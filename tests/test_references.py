@@ -50,6 +50,8 @@ def exists(token):
     """A tracked file or folder, or a glob (tests/test_*.c, contact.[ch]) that matches one."""
     # CMake's tests/test_${name}.c, an f-string's tests/{name}: any name there
     token = re.sub(r"\$?\{[^}]*\}", "*", token.rstrip(".").rstrip("/"))
+    if token.count("]") > token.count("["):  # a markdown link's [docs/x.md](...)
+        token = token[:token.rindex("]")]
     if any(c in token for c in "*["):
         return bool(fnmatch.filter(FILES, token)) or any(fnmatch.fnmatch(f, token) for f in FOLDERS)
     return token in FILES or token in FOLDERS
@@ -94,7 +96,8 @@ def test_every_model_section_cited_exists():
 
 @pytest.mark.parametrize("line, bad", [("see scripts/stability.py", True), ("see docs/nothing.md", True),
                                        ("tests/test_*.c", False), ("fmu_src/model/g1.[ch]", False),
-                                       ("reports/gone.py", True), ("fraccontact/cosim.py", False)])
+                                       ("reports/gone.py", True), ("fraccontact/cosim.py", False),
+                                       ("[docs/model.md](model.md)", False), ("[docs/gone.md](gone.md)", True)])
 def test_the_scan_finds_what_it_should(line, bad):
     """The scanner itself, on lines written for it: it must be able to fail."""
     tokens = PATH.findall(line)
@@ -102,3 +105,19 @@ def test_the_scan_finds_what_it_should(line, bad):
     missing += [t for t in PY_PATH.findall(line)
                 if not t.startswith(TOP) and not any(f == t or f.endswith("/" + t) for f in FILES)]
     assert bool(missing) == bad, (line, tokens, missing)
+
+
+LINK = re.compile(r"\]\(([^)\s#]+)(?:#[^)]*)?\)")
+
+
+def test_every_markdown_link_resolves():
+    """A page's relative link ([x](model.md), [y](../README.md)) reaches a file of the repository."""
+    broken = []
+    for name, lines in scanned():
+        if name.endswith(".md"):
+            for i, line in enumerate(lines, 1):
+                for target in LINK.findall(line):
+                    if "://" not in target and not exists(str(pathlib.PurePosixPath(name).parent / target)
+                                                            .replace("docs/../", "")):
+                        broken.append(f"{name}:{i}: {target}")
+    assert not broken, "links to a file the repository does not have:\n" + "\n".join(broken)
