@@ -39,7 +39,7 @@ def test_two_free_bodies_are_the_single_body_impact_of_the_reduced_mass(m1, m2, 
     for name, value in two.items():
         # scipy at rtol 1e-12 and the library's error control at its finest
         # tolerance, 1e-12, whose figures come within about 15 tolerances
-        # (README, "Error-controlled steps"); the peak is taken from 200001
+        # (docs/numerics.md, "Error-controlled steps"); the peak is taken from 200001
         # samples of the contact (1e-11).
         assert value == pytest.approx(getattr(one, name), rel=1e-9, abs=0), name
     # Equal and opposite forces: the momentum is the integrator's linear
