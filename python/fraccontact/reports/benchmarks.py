@@ -147,7 +147,7 @@ LADDER_SECONDS = 2.0  # a ladder stops after a setting costing more per impact: 
 ROUNDS = 7            # head-to-head rounds of the cheapest settings
 FMU_H = 2e-3          # one doStep over the whole h20 contact (1.32 ms)
 # The FMU's settings: label, tolerance, dt_max, one-doStep impacts a round.
-# The issue names tolerance 1e-6; 5e-8 is the README's setting for the four
+# The issue names tolerance 1e-6; 5e-8 is docs/numerics.md's setting for the four
 # figures within 1e-6 (a twentieth of the target), so it is measured too.
 FMU_FIXED = "fixed: tolerance 0, dt_max 1e-7 s (the defaults)"
 FMU_SETTINGS = (("adaptive: tolerance 1e-6, dt_max 1e-3 s", 1e-6, 1e-3, 60),

@@ -65,7 +65,7 @@ TABLE = {
                                 "c v^2 without inertia: no run can have finite outputs, whatever m becomes")},
     "m": {"0": (REFUSED_INIT, "the drop test needs a mass (0 is the driven scene's 'no inertia')"),
           "negative": (REFUSED_SET, "a mass is >= 0"),
-          "denormal": (REFUSED_SET, "1/m would overflow (README)"),
+          "denormal": (REFUSED_SET, "1/m would overflow (docs/variables.md)"),
           "huge": ("constant rate", "valid: a striker of 1e300 kg does not slow down, a constant-rate drive")},
     "R": {"0": (REFUSED_SET, "R > 0"), "negative": (REFUSED_SET, "R > 0"),
           "denormal": ("reference", MATERIAL), "huge": ("reference", MATERIAL)},
@@ -78,13 +78,13 @@ TABLE = {
     "nu_s": {"0": ("reference", MATERIAL), "negative": (REFUSED_SET, "a Poisson ratio lies in (-1, 0.5]"),
              "denormal": ("reference", MATERIAL), "huge": (REFUSED_SET, "a Poisson ratio lies in (-1, 0.5]")},
     "k": {"0": ("reference", "valid: k derived from R, E_i, nu_i, E_s, nu_s (docs/model.md §2)"),
-          "negative": (REFUSED_SET, "k >= 0"), "denormal": (REFUSED_SET, "1/k would overflow (README)"),
+          "negative": (REFUSED_SET, "k >= 0"), "denormal": (REFUSED_SET, "1/k would overflow (docs/variables.md)"),
           "huge": ("rigid spring", "valid: a rigid spring, the dashpot alone stops the striker")},
     "c": {"0": (REFUSED_SET, "c > 0"), "negative": (REFUSED_SET, "c > 0"),
-          "denormal": (REFUSED_SET, "1/c would overflow (README)"),
+          "denormal": (REFUSED_SET, "1/c would overflow (docs/variables.md)"),
           "huge": ("elastic Hertz", "valid: a rigid dashpot, the elastic Hertz impact")},
     "dt_max": {"0": ("reference", "valid: the default, fixed steps of 1e-7 s"), "negative": (REFUSED_SET, "dt_max >= 0"),
-               "denormal": (REFUSED_SET, "dt_max must be normal (README)"),
+               "denormal": (REFUSED_SET, "dt_max must be normal (docs/variables.md)"),
                "huge": ("reference", "valid: the internal steps are the 1e-5 s communication steps")},
     "g": {"0": ("reference", "no gravity (the default)"),
           "negative": ("reference", "valid: pulls the striker away; free flight after the rebound"),
@@ -123,7 +123,7 @@ def cases():
     yield "communication step 1e-15 s", case("reference", "valid: ten steps of 1e-15 s, then the h20 test",
                                              steps=[["step", 1e-15]] * 10 + DEFAULT_STEPS)
     yield "communication step 1e3 s", case("one long step", "valid: the impact's internal steps, then free flight "
-                                                            "in one exact step (README)", steps=[["step", 1e3]])
+                                                            "in one exact step (docs/numerics.md)", steps=[["step", 1e3]])
     yield "communication step 1e3 s, dt_max 1 s", case(
         "one long step", "valid: the whole impact inside one internal step", values={"dt_max": 1.0},
         steps=[["step", 1e3]])
