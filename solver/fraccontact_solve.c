@@ -634,7 +634,7 @@ static void watch_start(progress_line *line, const options *o, const series *row
     line->o = o;
     line->rows = rows;
     line->shown = 0;
-    /* not otherwise: --repeat times the solve, and a clock read costs about 0.6 us */
+    /* not otherwise: --repeat times the solve, and a clock read would be in the timing */
     line->next = !o->quiet && !o->json && isatty(STDERR_FILENO) ? cpu_seconds() + PROGRESS_AFTER : 0.0;
 }
 
