@@ -184,7 +184,7 @@ int fc_error_controlled(const fc_params *p)
     return contact_error_controlled(&q);
 }
 
-/* t_c v / x_max of an elastic impact on the spring k x1^n (MODEL.md §2):
+/* t_c v / x_max of an elastic impact on the spring k x1^n (docs/model.md §2):
  * 2 integral_0^1 (1 - u^(n+1))^(-1/2) du = 2/(n+1) B(1/(n+1), 1/2). */
 static double elastic_contact_time(double n)
 {

@@ -146,7 +146,7 @@ static void usage(const option_table *t)
     size_t i;
     printf("usage: " PROGRAM " [OPTION VALUE]... [--json] [--reference]\n"
            "Simulates an impact on a Hertz spring in series with a dashpot, the spring force\n"
-           "computed by the G1 Grunwald-Letnikov semi-integral (MODEL.md). Defaults: the paper's\n"
+           "computed by the G1 Grunwald-Letnikov semi-integral (docs/model.md). Defaults: the paper's\n"
            "h20 drop test. Options take a value as '--opt VALUE' or '--opt=VALUE'; the model's\n"
            "options are the FMU's variables (--dt-max for dt_max).\n\n");
     for (i = 0; i < t->n; i++)
@@ -634,7 +634,7 @@ static void watch_start(progress_line *line, const options *o, const series *row
     line->o = o;
     line->rows = rows;
     line->shown = 0;
-    /* not otherwise: --repeat times the solve, and a clock read costs about 0.6 us */
+    /* not otherwise: --repeat times the solve, and a clock read would be in the timing */
     line->next = !o->quiet && !o->json && isatty(STDERR_FILENO) ? cpu_seconds() + PROGRESS_AFTER : 0.0;
 }
 

@@ -199,7 +199,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def readme_python_section():
-    text = open(os.path.join(ROOT, "README.md")).read()
+    text = open(os.path.join(ROOT, "docs", "python.md")).read()
     return text.split("## In Python: the `fraccontact` package", 1)[1].split("\n## ", 1)[0]
 
 

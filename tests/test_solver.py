@@ -194,7 +194,7 @@ def test_no_figure_depends_on_the_output_interval(method, tmp_path):
 def test_per_impact_figures_against_the_reference():
     """Each impact's figures from the model (Hertz law, dt 1e-7) against the
     GSL reference, impact by impact. The scheme's error at this step is about
-    1e-9 relative for h20 (README: 8.7e-10 in F_peak, 3.3e-9 in eps); free
+    1e-9 relative for h20 (docs/benchmarks.md: 8.7e-10 in F_peak, 3.3e-9 in eps); free
     flight is exact, so later impacts inherit only that: 1e-7 leaves two
     orders of margin and fails any mix-up between impacts (they differ by
     tens of percent)."""
@@ -493,7 +493,7 @@ def test_the_reference_warns_that_the_models_steps_change_nothing(option, value)
 def test_the_reference_says_which_law_it_solves():
     """Without --law the reference solves the G1 law's continuous limit, the
     Hertz law, and says so; the same figures as --law hertz to the bit. With
-    a fixed N it solves the G1 law on N intervals (MODEL.md §4): the
+    a fixed N it solves the G1 law on N intervals (docs/model.md §4): the
     model's figures at a fine step, not the Hertz law's."""
     assert solve("--reference").stdout.startswith("reference, law hertz,")
     hertz = without_timing(solve_json("--reference", "--law", "hertz"))

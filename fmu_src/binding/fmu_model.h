@@ -1,4 +1,4 @@
-/* The contact FMU's variables (DESIGN.md: the interface table) on top of the
+/* The contact FMU's variables (docs/variables.md) on top of the
  * contact model: value references, start values, who may set what and when,
  * and the mapping of a communication step onto the model. It implements
  * fmu_interface.h for the FMI glue. */

@@ -244,7 +244,7 @@ def warning(**params):
 def memory_kernel(**params):
     """The compressed memory's kernel for these parameters (damper_order,
     memory_tolerance, dt_max, and whether error-controlled steps apply, which
-    fit it from min(dt_max, 1e-9 s); MODEL.md §8): (a, b, eta) with
+    fit it from min(dt_max, 1e-9 s); docs/model.md §6): (a, b, eta) with
     tau^(-alpha)/Gamma(1-alpha) ~ eta delta(tau) + sum a_i exp(-b_i tau),
     the last term the lumped spring (b = 0)."""
     p = _params(**params)
