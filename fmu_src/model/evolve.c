@@ -16,8 +16,9 @@
 /* One SDIRK step of length h, split at contact onset and separation.
  * Returns 0, 1 when it stopped early at an event of the mask stop_at (the
  * state's time tells where), or -1 when the events do not end (a diverging
- * state). */
-static int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
+ * state). Inline, as the controlled step below: contact_advance_until's
+ * loop takes one at every internal step, and a call costs speed there. */
+static inline int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s, trial;
     int events;
@@ -69,8 +70,8 @@ static int sdirk_internal_step(contact_model *cm, double h, double *impulse, uns
  * at separation: 0, 1 when it stopped at separation with CONTACT_SEPARATION
  * in stop_at, or -1 when no step length is accepted (a diverging state);
  * *advanced is the length stepped. */
-static int controlled_internal_step(contact_model *cm, double remaining, double *impulse, unsigned stop_at,
-                                    double *advanced)
+static inline int controlled_internal_step(contact_model *cm, double remaining, double *impulse, unsigned stop_at,
+                                           double *advanced)
 {
     contact_state *s = &cm->s, trial;
     const double K = spring_stiffness(cm, s->n + 1);
