@@ -160,7 +160,7 @@ MUTANTS = [
            (EVENTS, "return event_time(cm, s, h, K, indentation, trial->x1, 1e-15",
             "return event_time(cm, s, h, K, indentation, trial->x1 + 1e-10, 1e-15")),
     mutant("peak-in-step", "events", "F_peak sampled at step ends only (the peak inside a step dropped)",
-           STRUCTURAL + "; ~(π h / t_c)²/8 ~ 7e-9 at dt 1e-7 (contact.c: more than the scheme's error)",
+           STRUCTURAL + "; ~(π h / t_c)²/8 ~ 7e-9 at dt 1e-7 (events.c, force_at_turn: more than the scheme's error)",
            (EVENTS, "return at.F > end->F ? at.F : end->F;", "return end->F;")),
     # ---------------------------------------------------------- proxy striker
     mutant("proxy-gravity", "proxy striker", "the driven scene's proxy striker ignores g",
