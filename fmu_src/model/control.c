@@ -26,8 +26,8 @@ static double double_of(uint64_t b)
 /* x^(-1/5) for normal x > 0 to within 3e-4 relative: writing x = f 2^e
  * with f in [0.5, 1) and e = 5q + r, it is f^(-1/5) (a cubic, fitted here)
  * times 2^(-r/5) times 2^(-q), f and e read from x's bits (frexp and ldexp
- * are library calls: 3 % of an h20 impact). A step controller needs no
- * more, and it runs on every step, where pow costs a tenth of an impact. */
+ * are library calls). A step controller needs no more, and it runs on
+ * every step, where pow is costly. */
 static double inverse_fifth_root(double x)
 {
     static const double two_to_minus_fifths[5] = {1.0, 0.8705505632961241, 0.7578582832551990,
@@ -55,9 +55,8 @@ double next_step(double h, double error, double least)
  * F / c into the dashpot, has moved the indentation by ONSET_MOVEMENT
  * tolerances relative to v h; x1^n is not smooth there, and the steps that
  * follow grow at most 5-fold each (grading). The ESDIRK's error on that
- * first step is a small part of the movement: measured on the h20 impact
- * (law 2, tolerance 1e-7), 1e-4 of it, so that a movement of 1000
- * tolerances leaves an estimated error of 0.09 of the tolerance. */
+ * first step is a small part of the movement, so that a movement of 1000
+ * tolerances leaves an estimated error well within the tolerance. */
 #define ONSET_MOVEMENT 1000.0
 
 /* An error-controlled step where nothing sets its scale (a contact that
@@ -84,16 +83,15 @@ double onset_step(const contact_model *cm)
 /* While a springpot's dent recovers in free flight, its memory relaxes on
  * the time scale of the time since separation: steps of a fraction f of it
  * (at least dt_max), O(log) many however long the flight. SDIRK2's error in
- * the recovery is O(f^2) (the second impact's eps was off by 4.7e-6 at
- * f = 1/8, 1.2e-6 at 1/16), so f shrinks with dt_max, f = RECOVERY_STEPS
+ * the recovery is O(f^2), so f shrinks with dt_max, f = RECOVERY_STEPS
  * dt_max / t_contact (at most 1/16), for an error of O(dt_max^2) like the
- * contact's: the flight to the next impact then takes about a sixth of the
- * last contact's steps. */
+ * contact's. */
 #define RECOVERY_STEPS 64.0
 
 /* The recovery's steps as a fraction of the time since separation. With
  * error-controlled steps dt_max says nothing of the accuracy wanted: the
- * fraction whose O(f^2) error (1.2e-6 at 1/16) is the tolerance. */
+ * fraction whose O(f^2) error (its constant, 1.2e-6 at 1/16, below) is the
+ * tolerance. */
 static double recovery_fraction(const contact_model *cm)
 {
     const contact_state *s = &cm->s;

@@ -9,15 +9,13 @@
 
 #include "stage.h"
 
-/* Kvaerno's ESDIRK of order 5 with an embedded solution of order 4
- * (A. Kvaerno, BIT 44 (2004) 489-502): an explicit first stage, then six
- * implicit stages of one diagonal gamma. Both solutions are L-stable and
+/* Kvaerno's ESDIRK of order 5 with an embedded solution of order 4: an
+ * explicit first stage, then six implicit stages of one diagonal gamma. Both solutions are L-stable and
  * stiffly accurate: the step's end is its last stage, the embedded
  * solution its sixth, so that their difference estimates the step's error
  * at no extra cost, and a step far too long for the motion damps it rather
- * than reflecting it. Measured on the h20 impact against the order 3(2)
- * of the same paper: at tolerance 1e-6 it takes 17 steps where that takes
- * 210, and its 6 stages per step cost less than twice the other's 3. */
+ * than reflecting it. Its order keeps the steps of a tight tolerance few
+ * (docs/model.md §12). */
 #define ESDIRK_STAGES 7
 #define ESDIRK_EMBEDDED 5
 #define ESDIRK_GAMMA 0.26
@@ -154,8 +152,7 @@ void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
  * error counts as the travel it would drive over the step through the
  * stage's viscosity. The springpot's E_diss is the order-5 quadrature of
  * F x2', as the dashpot's of F^2/c (SDIRK2's mean force times the travel
- * is of order 2: measured 3e-3 off on the h20 impact at tolerance 1e-6,
- * where this is 2e-5). */
+ * is of order 2 only). */
 static inline double esdirk_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
                                     esdirk_memory *mem)
 {

@@ -220,21 +220,15 @@ static int unused_damper_value(const contact_params *p, char *msg, size_t len)
     return 1;
 }
 
-/* The shortest time over which the compressed memory's kernel holds its
- * tolerance. Fixed steps never go below dt_max. Error-controlled steps do,
- * far below it (the h20 impact's first steps at tolerance 1e-6 are about
- * 1e-7 s, at 1e-10 below 1e-9 s), and dt_max may be long (1e-3 s): on time
+/* The shortest time delta over which the compressed memory's kernel holds
+ * its tolerance. Fixed steps never go below dt_max. Error-controlled steps
+ * do, far below it at tight tolerances, and dt_max may be long: on time
  * scales under delta the kernel's fitted part flattens out and its lumped
  * dashpot eta takes over, so the springpot would act as a dashpot there.
- * CONTACT_MEMORY_FLOOR = 1e-9 s is the smallest delta whose kernel fits
- * CONTACT_MAX_MODES at every alpha and memory_tolerance (at most 155 modes,
- * at 1e-12; 70 at the default 1e-6, 62 from dt_max = 1e-7): below it only
- * the onset's first steps of tight tolerances go, where the force and with
- * it the damper's share are negligible. Measured on the springpot's h20
- * impact (tolerance 1e-10, memory_tolerance 1e-10) against the full G1
- * history's extrapolated figures: F_peak, eps, t_contact and x2_end within
- * 1.3e-9 at alpha 0.5 and 0.8 with delta = 1e-9 s and 1e-11 s alike (the
- * steps' own error), up to 3.7e-8 off with delta = 1e-7 s. */
+ * CONTACT_MEMORY_FLOOR is the smallest delta whose kernel fits
+ * CONTACT_MAX_MODES at every alpha and memory_tolerance: below it only the
+ * onset's first steps of tight tolerances go, where the force and with it
+ * the damper's share are negligible (docs/model.md §6). */
 double memory_kernel_floor(const contact_params *p)
 {
     return contact_error_controlled(p) ? fmin(contact_step_limit(p), CONTACT_MEMORY_FLOOR) : contact_step_limit(p);
