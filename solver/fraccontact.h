@@ -95,6 +95,10 @@ FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
  * 0 when it takes fixed steps of dt_max. */
 FC_API int fc_error_controlled(const fc_params *p);
 
+/* The method the run takes, as the model names it (contact_method_name):
+ * "sdirk2", "esdirk54", "g1_history" or "central". */
+FC_API const char *fc_method_name(const fc_params *p);
+
 /* The largest internal step of these parameters [s]: dt_max, or for
  * dt_max = 0 the fixed step of 1e-7 s, or INFINITY where error-controlled
  * steps have no cap. */

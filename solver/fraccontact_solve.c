@@ -173,7 +173,7 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, esdirk5 (error-controlled steps, tolerance > 0), central, bdf2-g1 (a\n"
+           "  method, k    sdirk2, esdirk54 (error-controlled steps, tolerance > 0), central, g1_history (a\n"
            "               springpot's full G1 history) or reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed, 130 interrupted (Ctrl-C).\n"
@@ -504,11 +504,7 @@ static const char *method_name(const options *o)
 {
     if (o->reference)
         return "reference";
-    if (o->p.damper == 2 && o->p.memory == 1)
-        return "bdf2-g1"; /* the full G1 history's own scheme */
-    if (fc_error_controlled(&o->p))
-        return "esdirk5"; /* error-controlled steps: Kvaerno's ESDIRK 5(4) */
-    return o->p.scheme == 2 ? "central" : "sdirk2";
+    return fc_method_name(&o->p);
 }
 
 /* "name": value for each figure of an impact; null for a missing one. */

@@ -155,7 +155,7 @@ def test_words_mixed_with_codes_in_one_array():
 # --- item 24: one shape of result ------------------------------------------
 
 RUN_FIELDS = ["t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss", "per_impact", "end",
-              "stopped", "impacts", "steps", "k"]
+              "stopped", "impacts", "steps", "k", "method"]
 END_FIELDS = ["t", "F_peak", "eps", "t_contact", "E_diss", "x", "x1", "x2", "v"]
 SERIES_FIELDS = ["t", "F", "x", "x1", "x2", "v", "E_diss", "run"]
 

@@ -210,7 +210,7 @@ def test_tolerance_alone_chooses_the_steps():
     controlled steps")."""
     r = solve_json("--law", "hertz", "--height", 0.02, "--tolerance", 1e-6)
     ref = reference("--height", 0.02)
-    assert r["steps"] < 30 and r["method"] == "esdirk5"
+    assert r["steps"] < 30 and r["method"] == "esdirk54"
     for key in ("F_peak", "eps", "t_contact", "x2_end"):
         assert r[key] == pytest.approx(ref[key], rel=15e-6, abs=0), key
     assert fraccontact.impact(law="hertz", tolerance=1e-6).steps == r["steps"]

@@ -55,7 +55,7 @@ def reference(*args):
 
 
 # Alexander's SDIRK2 and the Taylor coefficients of R(z) - e^z (docs/model.md
-# §11; contact.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
+# §11; sdirk2.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
 SDIRK = 1.0 - 1.0 / math.sqrt(2.0)
 C3 = 3 * SDIRK ** 2 - 2 * SDIRK ** 3 - 1.0 / 6.0     # 0.0404401...
 C4 = 4 * SDIRK ** 3 - 3 * SDIRK ** 4 - 1.0 / 24.0    # 0.0367550...
@@ -483,7 +483,7 @@ def spring_k(n):
 
 def equivalent_c_alpha(alpha, c=6080.0, omega=2400.0):
     """A springpot as damping as the h20 dashpot at the impact's frequency
-    pi/t_c (the default c_alpha's rule, contact.c): c_alpha omega^alpha = c omega."""
+    pi/t_c (the default c_alpha's rule, parameters.c): c_alpha omega^alpha = c omega."""
     return c * omega ** (1 - alpha)
 
 
