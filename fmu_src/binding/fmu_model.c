@@ -154,7 +154,8 @@ static int check_bodies(const contact_params *p, int scene, const bodies *b, cha
                               "the second body's mass must be positive, finite and not denormal, or 0 (held "
                               "fixed) [kg]");
     if (!isfinite(b->a))
-        return contact_reject(why, len, "a", b->a, "the striker's acceleration from its other forces must be finite [m/s^2]");
+        return contact_reject(why, len, "a", b->a,
+                              "the striker's acceleration from its other forces must be finite [m/s^2]");
     if (!isfinite(b->a2))
         return contact_reject(why, len, "a2", b->a2,
                               "the second body's acceleration from its other forces must be finite [m/s^2]");
@@ -694,8 +695,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
-    I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a), F(in.a2),
-    F(v_slope), F(F_avg), F(step_span),
+    I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
+    F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
