@@ -239,3 +239,13 @@ def test_the_readme_ssp_examples_print_what_they_say(master):
     printed = [float(x) for x in re.findall(r"[-\d.e+]+", run_block(block))]
     said = float(re.search(r"# (\d+\.\d+) N", block).group(1))
     assert printed[0] == pytest.approx(said, abs=0.005, rel=0)  # the comment's two decimals
+
+
+def test_the_readme_tree_names_every_file_of_the_model():
+    """The short tree is where a newcomer looks for a method, the controller
+    or the event location: a file added or renamed must show there."""
+    tree = README[README.index("  model/"):README.index("  glue/")]
+    named = set(re.findall(r"[\w.]+\.[ch]\b", tree))
+    files = {p.name for p in (ROOT / "fmu_src" / "model").iterdir() if p.suffix in (".c", ".h")}
+    assert files - named == set(), f"files of fmu_src/model/ missing from the README's tree: {sorted(files - named)}"
+    assert named - files == set(), f"the README's tree names files fmu_src/model/ does not have: {sorted(named - files)}"
