@@ -321,7 +321,7 @@ def write(path, results, forced, ref, ref_g, scene, g1, spring):
             "counts it twice.",
             "- Forces on the striker that the contact FMU does not know (a spring, a damper, gravity it was not "
             "given) reach the proxy through `v` only, one step late: an error of order (force/m) H / v0, first "
-            "order in H (the section above).", ""]
+            "order in H (the section above), unless the master feeds them as the input `a` (two_bodies.md).", ""]
     out += ssp_section(scene, ref, g1)
     out += ["## Every run", "",
             "| coupling | order | H [s] | F_peak error | eps error | energy error |", "|---|---|---|---|---|---|"]
@@ -412,9 +412,10 @@ def spring_section(spring):
             "first order in H, the same in libcosim and with Gauss-Seidel and `F_avg`.",
             "- **It creates energy**, of the order of that error (the energy error above includes the spring's "
             "energy k_s x^2 / 2 at the end): the proxy's force misses the spring's share of each step, so the "
-            "exchanged force and the striker's motion no longer do equal work. No coupling of this FMU can avoid "
-            "it while the spring is outside it: choose H so that (k_s x / m) H / v0 is below the accuracy "
-            "needed, or model the spring where the contact sees it.", ""]
+            "exchanged force and the striker's motion no longer do equal work. Fed as the input `a` (the "
+            "spring's acceleration at each step's start), it falls to second order in H: "
+            "[two_bodies.md](two_bodies.md) measures it against H. Otherwise choose H so that "
+            "(k_s x / m) H / v0 is below the accuracy needed.", ""]
     return out
 
 
