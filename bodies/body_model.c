@@ -5,8 +5,10 @@
  * second body: +F). The anchor is the ground (x_a = v_a = 0, the defaults)
  * or another body, whose position and velocity the master connects to x_a
  * and v_a. Outputs: its position x and velocity v (from where it starts,
- * towards the impact), the acceleration a its own spring and damper give it
- * now (what a contact's proxy needs to move as the body does), and its mass.
+ * towards the impact), its mass, and the accelerations a contact's proxy
+ * needs to move as the body does: a, of every force but F (the spring, the
+ * damper and F2), for the contact it strikes (that contact's input a), and
+ * a2, of every force but F2, for the contact that strikes it (its a2).
  *
  * Over a step the forces are held and the anchor moves at v_a; the relative
  * motion y = x - x_a then obeys y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m,
@@ -21,13 +23,13 @@
 
 enum {
     VR_F = 1, VR_F2 = 2, VR_x_a = 3, VR_v_a = 4, VR_m = 5, VR_k_s = 6, VR_c_s = 7, VR_v0 = 8,
-    VR_x = 9, VR_v = 10, VR_a = 11, VR_mass = 12
+    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13
 };
 
 struct fmu_model {
     double F, F2, x_a, v_a; /* inputs */
     double m, k_s, c_s, v0; /* parameters */
-    double x, v, a, mass;   /* outputs */
+    double x, v, a, a2, mass; /* outputs */
     double t;
     double anchor; /* the anchor's position now: x_a as last set, moved on at v_a over the steps since */
     int started;
@@ -46,6 +48,7 @@ static const fmu_variable variable_list[] = {
     {VR_x, "x", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, x)},
     {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
     {VR_a, "a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a)},
+    {VR_a2, "a2", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a2)},
     {VR_mass, "mass", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, mass)},
 };
 
@@ -60,7 +63,9 @@ static double own_acceleration(const fmu_model *fm)
 /* The outputs that follow from the state and the inputs. */
 static void update_outputs(fmu_model *fm)
 {
-    fm->a = own_acceleration(fm);
+    const double own = own_acceleration(fm);
+    fm->a = own + fm->F2 / fm->m;
+    fm->a2 = own - fm->F / fm->m;
     fm->mass = fm->m;
 }
 
