@@ -8,7 +8,8 @@
  * towards the impact), its mass, and the accelerations a contact's proxy
  * needs to move as the body does: a, of every force but F (the spring, the
  * damper and F2), for the contact it strikes (that contact's input a), and
- * a2, of every force but F2, for the contact that strikes it (its a2).
+ * a2, of every force but F2, for the contact that strikes it (its a2); and
+ * E_diss, the work its damper has dissipated.
  *
  * Over a step the forces are held and the anchor moves at v_a; the relative
  * motion y = x - x_a then obeys y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m,
@@ -23,13 +24,13 @@
 
 enum {
     VR_F = 1, VR_F2 = 2, VR_x_a = 3, VR_v_a = 4, VR_m = 5, VR_k_s = 6, VR_c_s = 7, VR_v0 = 8,
-    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13
+    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14
 };
 
 struct fmu_model {
     double F, F2, x_a, v_a; /* inputs */
     double m, k_s, c_s, v0; /* parameters */
-    double x, v, a, a2, mass; /* outputs */
+    double x, v, a, a2, mass, E_diss; /* outputs */
     double t;
     double anchor; /* the anchor's position now: x_a as last set, moved on at v_a over the steps since */
     int started;
@@ -50,6 +51,7 @@ static const fmu_variable variable_list[] = {
     {VR_a, "a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a)},
     {VR_a2, "a2", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a2)},
     {VR_mass, "mass", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, mass)},
+    {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, E_diss)},
 };
 
 static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
@@ -194,6 +196,7 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->t = t0;
     fm->x = 0.0;
     fm->v = fm->v0;
+    fm->E_diss = 0.0;
     fm->started = 1;
     update_outputs(fm);
     return FM_OK;
@@ -245,6 +248,10 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
         y_end = y + H * (y_rate + 0.5 * H * f);
         y_rate_end = y_rate + H * f;
     }
+    /* In the frame of the anchor (moving at constant v_a over the step) m y'' y' = m f y' - k_s y y' - c_s y'^2:
+     * the damper's work over the step is exact from the step's ends. */
+    fm->E_diss += fm->m * f * (y_end - y)
+                  - 0.5 * fm->m * (y_rate_end * y_rate_end - y_rate * y_rate) - 0.5 * fm->k_s * (y_end * y_end - y * y);
     fm->anchor += fm->v_a * H;
     fm->x = fm->anchor + y_end;
     fm->v = fm->v_a + y_rate_end;
@@ -261,7 +268,7 @@ double fm_time(const fmu_model *fm)
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
 static const state_field state_fields[] = {F(F),  F(F2), F(x_a), F(v_a),  F(m),      F(k_s), F(c_s),
-                                           F(v0), F(x),  F(v),   F(t),    F(anchor),
+                                           F(v0), F(x),  F(v),   F(t),    F(anchor), F(E_diss),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
