@@ -513,7 +513,7 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
     }
 }
 
-void contact_drive(contact_model *cm, double v, double m, double slope)
+void contact_drive(contact_model *cm, double v, double m, double accel)
 {
     if (cm->p.scene != CONTACT_SCENE_DRIVEN)
         return;
@@ -521,7 +521,7 @@ void contact_drive(contact_model *cm, double v, double m, double slope)
         cm->s.h_prev = 0.0; /* a multistep scheme's past no longer leads here: restart it */
     cm->s.v = v;
     cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;
-    cm->accel = m > 0.0 ? cm->p.g : slope;
+    cm->accel = m > 0.0 ? cm->p.g + accel : accel;
     resolve_contact(cm);
 }
 

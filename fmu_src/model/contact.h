@@ -293,10 +293,12 @@ int contact_check_history_span(const contact_params *p, double v, double m, doub
 int contact_steps_uniformly(const contact_model *cm);
 
 /* Driven scene: the indentation rate v from now on; m > 0 lets the model move
- * the striker with that inertia until the next call (a proxy striker), m = 0
- * prescribes the rate: v + slope (t - now) (slope 0: v held). The drop test
- * ignores the call: its striker is the model's own. */
-void contact_drive(contact_model *cm, double v, double m, double slope);
+ * the striker with that inertia until the next call (a proxy striker), under
+ * g + accel besides the contact force (accel: what the caller's other forces
+ * give the striker, relative to the specimen), m = 0 prescribes the rate:
+ * v + accel (t - now) (accel 0: v held). The drop test ignores the call: its
+ * striker is the model's own. */
+void contact_drive(contact_model *cm, double v, double m, double accel);
 
 /* The state's rates now: x1' (0 out of contact), v', and the spring force's
  * F' = n K x1^(n-1) x1' at the current stiffness. */
