@@ -2,18 +2,20 @@
  * by a spring k_s and a damper c_s in parallel (unstretched at the start),
  * pushed by two contact forces: F against its motion (the contact in which
  * it is the striker: -F) and F2 along it (the contact in which it is the
- * second body: +F). The anchor is the ground (x_a = v_a = 0, the defaults)
- * or another body, whose position and velocity the master connects to x_a
- * and v_a. Outputs: its position x and velocity v (from where it starts,
+ * second body: +F). The anchor is the ground (x_a = v_a = a_a = 0, the defaults)
+ * or another body, whose position, velocity and acceleration the master
+ * connects to x_a, v_a and a_a. Outputs: its position x and velocity v (from where it starts,
  * towards the impact), its mass, and the accelerations a contact's proxy
  * needs to move as the body does: a, of every force but F (the spring, the
  * damper and F2), for the contact it strikes (that contact's input a), and
  * a2, of every force but F2, for the contact that strikes it (its a2); and
- * E_diss, the work its damper has dissipated.
+ * a_total, of every force (another body's anchor acceleration a_a); E_diss,
+ * the work its damper has dissipated.
  *
- * Over a step the forces are held and the anchor moves at v_a; the relative
- * motion y = x - x_a then obeys y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m,
- * integrated exactly (a damped oscillator, whatever its damping). */
+ * Over a step the forces are held and the anchor moves at the constant
+ * acceleration a_a; the relative motion y = x - x_a then obeys
+ * y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m - a_a, integrated exactly (a
+ * damped oscillator, whatever its damping). */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -24,15 +26,16 @@
 
 enum {
     VR_F = 1, VR_F2 = 2, VR_x_a = 3, VR_v_a = 4, VR_m = 5, VR_k_s = 6, VR_c_s = 7, VR_v0 = 8,
-    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14
+    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14,
+    VR_a_a = 15, VR_a_total = 16
 };
 
 struct fmu_model {
-    double F, F2, x_a, v_a; /* inputs */
+    double F, F2, x_a, v_a, a_a; /* inputs */
     double m, k_s, c_s, v0; /* parameters */
-    double x, v, a, a2, mass, E_diss; /* outputs */
+    double x, v, a, a2, a_total, mass, E_diss; /* outputs */
     double t;
-    double anchor; /* the anchor's position now: x_a as last set, moved on at v_a over the steps since */
+    double anchor, anchor_v; /* the anchor's position and velocity now: x_a, v_a as last set, moved on at a_a since */
     int started;
     fmu_reporter log;
 };
@@ -42,6 +45,7 @@ static const fmu_variable variable_list[] = {
     {VR_F2, "F2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F2)},
     {VR_x_a, "x_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, x_a)},
     {VR_v_a, "v_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v_a)},
+    {VR_a_a, "a_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, a_a)},
     {VR_m, "m", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, m)},
     {VR_k_s, "k_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, k_s)},
     {VR_c_s, "c_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, c_s)},
@@ -50,6 +54,7 @@ static const fmu_variable variable_list[] = {
     {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
     {VR_a, "a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a)},
     {VR_a2, "a2", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a2)},
+    {VR_a_total, "a_total", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a_total)},
     {VR_mass, "mass", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, mass)},
     {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, E_diss)},
 };
@@ -59,7 +64,7 @@ static const fmu_variables variables = {variable_list, sizeof variable_list / si
 /* The spring's and damper's acceleration of the body now. */
 static double own_acceleration(const fmu_model *fm)
 {
-    return -(fm->k_s * (fm->x - fm->anchor) + fm->c_s * (fm->v - fm->v_a)) / fm->m;
+    return -(fm->k_s * (fm->x - fm->anchor) + fm->c_s * (fm->v - fm->anchor_v)) / fm->m;
 }
 
 /* The outputs that follow from the state and the inputs. */
@@ -68,6 +73,7 @@ static void update_outputs(fmu_model *fm)
     const double own = own_acceleration(fm);
     fm->a = own + fm->F2 / fm->m;
     fm->a2 = own - fm->F / fm->m;
+    fm->a_total = own + (fm->F2 - fm->F) / fm->m;
     fm->mass = fm->m;
 }
 
@@ -122,6 +128,8 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
     *(double *)((char *)fm + var->offset) = value;
     if (vr == VR_x_a)
         fm->anchor = value;
+    if (vr == VR_v_a)
+        fm->anchor_v = value;
     if (!fm->started) /* before initialization the outputs show the start */
         fm->v = fm->v0;
     update_outputs(fm);
@@ -183,7 +191,7 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
         return FM_OK;
     }
     if (order == 1 && vr == VR_v) {
-        *value = own_acceleration(fm) + (fm->F2 - fm->F) / fm->m;
+        *value = fm->a_total;
         return FM_OK;
     }
     return fmu_say(&fm->log, FM_ERROR, "logStatusError",
@@ -228,11 +236,11 @@ static void damped(double beta, double w2, double t, double *eC, double *eS)
     }
 }
 
-/* The body over [t, t + H], forces held, the anchor moving at v_a. */
+/* The body over [t, t + H], forces held, the anchor moving at the acceleration a_a. */
 fm_status fm_do_step(fmu_model *fm, double t, double H)
 {
-    const double f = (fm->F2 - fm->F) / fm->m, beta = 0.5 * fm->c_s / fm->m, w2 = fm->k_s / fm->m;
-    const double y = fm->x - fm->anchor, y_rate = fm->v - fm->v_a;
+    const double f = (fm->F2 - fm->F) / fm->m - fm->a_a, beta = 0.5 * fm->c_s / fm->m, w2 = fm->k_s / fm->m;
+    const double y = fm->x - fm->anchor, y_rate = fm->v - fm->anchor_v;
     double y_end, y_rate_end;
     if (w2 > 0.0) { /* about the equilibrium f/w2 */
         const double z = y - f / w2;
@@ -248,13 +256,14 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
         y_end = y + H * (y_rate + 0.5 * H * f);
         y_rate_end = y_rate + H * f;
     }
-    /* In the frame of the anchor (moving at constant v_a over the step) m y'' y' = m f y' - k_s y y' - c_s y'^2:
+    /* In the frame of the anchor m y'' y' = m f y' - k_s y y' - c_s y'^2 (f with the frame's force -m a_a):
      * the damper's work over the step is exact from the step's ends. */
     fm->E_diss += fm->m * f * (y_end - y)
                   - 0.5 * fm->m * (y_rate_end * y_rate_end - y_rate * y_rate) - 0.5 * fm->k_s * (y_end * y_end - y * y);
-    fm->anchor += fm->v_a * H;
+    fm->anchor += H * (fm->anchor_v + 0.5 * H * fm->a_a);
+    fm->anchor_v += H * fm->a_a;
     fm->x = fm->anchor + y_end;
-    fm->v = fm->v_a + y_rate_end;
+    fm->v = fm->anchor_v + y_rate_end;
     fm->t = t + H;
     update_outputs(fm);
     return FM_OK;
@@ -267,7 +276,7 @@ double fm_time(const fmu_model *fm)
 
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
-static const state_field state_fields[] = {F(F),  F(F2), F(x_a), F(v_a),  F(m),      F(k_s), F(c_s),
+static const state_field state_fields[] = {F(F), F(F2), F(x_a), F(v_a), F(a_a), F(anchor_v), F(m), F(k_s), F(c_s),
                                            F(v0), F(x),  F(v),   F(t),    F(anchor), F(E_diss),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
