@@ -213,8 +213,8 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_con
         *bumper_conv,
         "",
         "The crash box is split across two FMUs (each body holds it, the other its anchor, moving at the "
-        "anchor's acceleration a_a over a step): the energy it creates is second order in H. Held at constant "
-        "velocity instead, the same scene created 4e-5 of the impact energy at H = 1e-5 (first order).",
+        "anchor's acceleration a_a over a step): the energy it creates is second order in H; held at constant "
+        "velocity instead, the anchor's error made it first order. fmpy's errors are its first step's (above).",
         "",
         "## HIC15 against the clearance",
         "",
