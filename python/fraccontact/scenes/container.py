@@ -9,9 +9,11 @@ container steps every embedded FMU from the values of the last internal step
 (not sequential: a Jacobi master), with the internal step H.
 """
 
+import contextlib
 import logging
 import pathlib
 import shutil
+import sys
 import tempfile
 
 from fmpy import simulate_fmu
@@ -52,15 +54,13 @@ def build(ssp, H, start, outputs, folder):
     return folder / f"{ssp.stem}.fmu"
 
 
-def quiet(*_):
-    """The container's log (its mode, its solver's setup): not the run's figures."""
-
-
 def simulate(ssp, H, t_end, start, outputs):
     """{output: values at 0, H, ..., t_end} of the container run by fmpy at
     communication step H."""
     with tempfile.TemporaryDirectory() as folder:
         fmu = build(pathlib.Path(ssp), H, start, outputs, folder)
-        rows = simulate_fmu(str(fmu), stop_time=t_end, step_size=H, output_interval=H, output=list(outputs),
-                            logger=quiet)
+        # fmpy prints the container's log (its mode, its solver's setup) on stdout, which is the
+        # command's: to stderr. (A logger of our own would outlive the call in fmpy's proxy.)
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = simulate_fmu(str(fmu), stop_time=t_end, step_size=H, output_interval=H, output=list(outputs))
     return {name: rows[name].astype(float) for name in outputs}
