@@ -16,12 +16,13 @@ COMMANDS = {
            "of heights) or measured force curves",
     "sweep": "parameter sweeps and Monte Carlo campaigns on Dask, a library call per task",
     "cosim": "the drop test as two FMUs (striker + contact) coupled through fmpy or libcosim",
+    "scene": "a crash scene (headform, bumper) as its SSP in fmpy, libcosim, a container FMU, or its reference",
     "report": "regenerate a report under docs/: fraccontact report NAME [OPTIONS...]",
 }
 MODULES = {"run": "fraccontact.reports.h20_drop", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
-           "cosim": "fraccontact.cosim"}
+           "cosim": "fraccontact.cosim", "scene": "fraccontact.scenes.cli"}
 # The extra of pyproject.toml's optional-dependencies that installs what each command imports.
-EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "report": "reports"}
+EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "scene": "cosim", "report": "reports"}
 
 
 def report_names():

@@ -3,7 +3,7 @@ with the contact element's law, solved as one ODE by scipy's solve_ivp with
 an event at every contact's onset and separation: the monolithic reference
 of the scenes.
 
-The contact law is MODEL.md §2 for two moving bodies: body i strikes body j
+The contact law is docs/model.md §2 for two moving bodies: body i strikes body j
 (or the fixed ground) once the gap between them has closed; the indentation
 x = u_i - u_j - gap splits into the spring's x1 and the dashpot's x2,
 

@@ -35,8 +35,8 @@ Low-speed bumper impact
 | bumper beam + fascia mass m_b | 5 kg | assumed | |
 | crash box stiffness k_box | 1e6 N/m (1 kN/mm) | assumed | elastic at these speeds (49 CFR 581: no damage) |
 | crash box damping c_box | 7.75e3 N s/m | assumed | damping ratio 0.1 of the body on the crash box |
-| fascia k (Hertz) | 2.92e9 N/m^1.5 | derived | k = (4/3) E* sqrt(R): polypropylene (2.64 GPa, 0.4: MODEL.md §6, the paper's h20 fit) against a steel barrier (210 GPa, 0.3), fascia radius of curvature 0.5 m (assumed) |
-| fascia c | 5.19e4 N s/m | derived | restitution 0.59 (the paper's h20, MODEL.md §6) of the beam alone striking the barrier at 2.5 mph with that k |
+| fascia k (Hertz) | 2.92e9 N/m^1.5 | derived | k = (4/3) E* sqrt(R): polypropylene (2.64 GPa, 0.4: docs/model.md §1, the paper's h20 fit) against a steel barrier (210 GPa, 0.3), fascia radius of curvature 0.5 m (assumed) |
+| fascia c | 5.19e4 N s/m | derived | restitution 0.59 (the paper's h20, docs/model.md §1) of the beam alone striking the barrier at 2.5 mph with that k |
 | vehicle-to-vehicle restitution | 0.2-0.4 at 2-5 mph | published | Howard, Bomar & Bare, SAE 931842 (quoted by issue 25), the comparison for the bumper's restitution |
 
 Elastic Hertz limit: HIC ~ m^(-3/(2(n+1))) v^((4n+1)/(n+1)), i.e. m^-0.6 v^2.8 at

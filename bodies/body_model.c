@@ -1,0 +1,309 @@
+/* The body FMU: a rigid body of mass m on the impact axis, held to an anchor
+ * by a spring k_s and a damper c_s in parallel (unstretched at the start),
+ * pushed by two contact forces: F against its motion (the contact in which
+ * it is the striker: -F) and F2 along it (the contact in which it is the
+ * second body: +F). The anchor is the ground (x_a = v_a = a_a = 0, the defaults)
+ * or another body, whose position, velocity and acceleration the master
+ * connects to x_a, v_a and a_a. Outputs: its position x and velocity v (from where it starts,
+ * towards the impact), its mass, and the accelerations a contact's proxy
+ * needs to move as the body does: a, of every force but F (the spring, the
+ * damper and F2), for the contact it strikes (that contact's input a), and
+ * a2, of every force but F2, for the contact that strikes it (its a2); and
+ * a_total, of every force (another body's anchor acceleration a_a); E_diss,
+ * the work its damper has dissipated.
+ *
+ * Over a step the forces are held and the anchor moves at the constant
+ * acceleration a_a; the relative motion y = x - x_a then obeys
+ * y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m - a_a, integrated exactly (a
+ * damped oscillator, whatever its damping). */
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmu_interface.h"
+#include "fmu_vars.h"
+
+enum {
+    VR_F = 1, VR_F2 = 2, VR_x_a = 3, VR_v_a = 4, VR_m = 5, VR_k_s = 6, VR_c_s = 7, VR_v0 = 8,
+    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14,
+    VR_a_a = 15, VR_a_total = 16
+};
+
+struct fmu_model {
+    double F, F2, x_a, v_a, a_a; /* inputs */
+    double m, k_s, c_s, v0; /* parameters */
+    double x, v, a, a2, a_total, mass, E_diss; /* outputs */
+    double t;
+    double anchor, anchor_v; /* the anchor's position and velocity now: x_a, v_a as last set, moved on at a_a since */
+    int started;
+    fmu_reporter log;
+};
+
+static const fmu_variable variable_list[] = {
+    {VR_F, "F", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F)},
+    {VR_F2, "F2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F2)},
+    {VR_x_a, "x_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, x_a)},
+    {VR_v_a, "v_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v_a)},
+    {VR_a_a, "a_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, a_a)},
+    {VR_m, "m", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, m)},
+    {VR_k_s, "k_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, k_s)},
+    {VR_c_s, "c_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, c_s)},
+    {VR_v0, "v0", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, v0)},
+    {VR_x, "x", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, x)},
+    {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
+    {VR_a, "a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a)},
+    {VR_a2, "a2", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a2)},
+    {VR_a_total, "a_total", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a_total)},
+    {VR_mass, "mass", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, mass)},
+    {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, E_diss)},
+};
+
+static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
+
+/* The spring's and damper's acceleration of the body now. */
+static double own_acceleration(const fmu_model *fm)
+{
+    return -(fm->k_s * (fm->x - fm->anchor) + fm->c_s * (fm->v - fm->anchor_v)) / fm->m;
+}
+
+/* The outputs that follow from the state and the inputs. */
+static void update_outputs(fmu_model *fm)
+{
+    const double own = own_acceleration(fm);
+    fm->a = own + fm->F2 / fm->m;
+    fm->a2 = own - fm->F / fm->m;
+    fm->a_total = own + (fm->F2 - fm->F) / fm->m;
+    fm->mass = fm->m;
+}
+
+fmu_model *fm_new(fm_report report, void *env)
+{
+    fmu_model *fm = calloc(1, sizeof *fm);
+    if (!fm)
+        return NULL;
+    fm->log.report = report;
+    fm->log.env = env;
+    fm_reset(fm);
+    return fm;
+}
+
+void fm_free(fmu_model *fm)
+{
+    free(fm);
+}
+
+void fm_reset(fmu_model *fm)
+{
+    fmu_reporter log = fm->log;
+    memset(fm, 0, sizeof *fm);
+    fm->log = log;
+    fm->m = 1.0;
+    update_outputs(fm);
+}
+
+/* The value's rule, or NULL if it is fine. */
+static const char *rule_broken(unsigned vr, double value)
+{
+    if (!isfinite(value))
+        return "must be finite";
+    if (vr == VR_m && !(value > 0.0))
+        return "the body's mass must be positive [kg]";
+    if (vr == VR_k_s && value < 0.0)
+        return "the spring's stiffness must not be negative [N/m]";
+    if (vr == VR_c_s && value < 0.0)
+        return "the damper's constant must not be negative [N s/m]";
+    return NULL;
+}
+
+fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
+{
+    const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
+    const char *why;
+    if (!var)
+        return FM_ERROR;
+    why = rule_broken(vr, value);
+    if (why)
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "%s = %g is invalid: %s", var->name, value, why);
+    *(double *)((char *)fm + var->offset) = value;
+    if (vr == VR_x_a)
+        fm->anchor = value;
+    if (vr == VR_v_a)
+        fm->anchor_v = value;
+    if (!fm->started) /* before initialization the outputs show the start */
+        fm->v = fm->v0;
+    update_outputs(fm);
+    return FM_OK;
+}
+
+fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
+{
+    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
+    if (!var)
+        return FM_ERROR;
+    *value = *(const double *)((const char *)fm + var->offset);
+    return FM_OK;
+}
+
+/* The body has no Integer and no Boolean variable: every reference to one
+ * is reported as unknown. */
+static fm_status none_of(fmu_model *fm, unsigned vr, var_type type)
+{
+    return fmu_find(&variables, vr, type, &fm->log) ? FM_OK : FM_ERROR;
+}
+
+fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
+{
+    (void)value;
+    return none_of(fm, vr, VAR_INTEGER);
+}
+
+fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
+{
+    (void)value;
+    return none_of(fm, vr, VAR_INTEGER);
+}
+
+fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
+{
+    (void)value;
+    return none_of(fm, vr, VAR_BOOLEAN);
+}
+
+fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
+{
+    (void)value;
+    return none_of(fm, vr, VAR_BOOLEAN);
+}
+
+fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
+{
+    (void)value;
+    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
+                   "fmi2SetRealInputDerivatives: value reference %u, order %d: the body holds its inputs", vr,
+                   order);
+}
+
+fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value)
+{
+    if (order == 1 && vr == VR_x) {
+        *value = fm->v;
+        return FM_OK;
+    }
+    if (order == 1 && vr == VR_v) {
+        *value = fm->a_total;
+        return FM_OK;
+    }
+    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
+                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x and v, order 1", vr, order);
+}
+
+fm_status fm_start(fmu_model *fm, double t0, double t_stop)
+{
+    (void)t_stop;
+    fm->t = t0;
+    fm->x = 0.0;
+    fm->v = fm->v0;
+    fm->E_diss = 0.0;
+    fm->started = 1;
+    update_outputs(fm);
+    return FM_OK;
+}
+
+/* e^(-beta t) C(t) and e^(-beta t) S(t) of the damped oscillator z'' + 2
+ * beta z' + w2 z = 0, where C'' = S'' = lambda (.), lambda = beta^2 - w2,
+ * C(0) = S'(0) = 1, C'(0) = S(0) = 0: z(t) = z0 eC + (z0' + beta z0) eS.
+ * No damping overflows. */
+static void damped(double beta, double w2, double t, double *eC, double *eS)
+{
+    const double lambda = beta * beta - w2;
+    if (lambda < 0.0) { /* underdamped */
+        const double wd = sqrt(-lambda), decay = exp(-beta * t);
+        *eC = decay * cos(wd * t);
+        *eS = decay * (wd * t > 0.0 ? sin(wd * t) / wd : t);
+    } else if (lambda > 0.0 && beta * t < 500.0) { /* overdamped: cosh and sinh stay finite */
+        const double gamma = sqrt(lambda), decay = exp(-beta * t);
+        *eC = decay * cosh(gamma * t);
+        *eS = decay * (gamma * t > 0.0 ? sinh(gamma * t) / gamma : t);
+    } else if (lambda > 0.0) { /* so overdamped that e^(beta t) would overflow: gamma - beta = -w2/(beta + gamma) */
+        const double gamma = sqrt(lambda), slow = exp(-w2 / (beta + gamma) * t), fast = exp(-(beta + gamma) * t);
+        *eC = 0.5 * (slow + fast);
+        *eS = 0.5 * (slow - fast) / gamma;
+    } else { /* critical */
+        const double decay = exp(-beta * t);
+        *eC = decay;
+        *eS = decay * t;
+    }
+}
+
+/* The body over [t, t + H], forces held, the anchor moving at the acceleration a_a. */
+fm_status fm_do_step(fmu_model *fm, double t, double H)
+{
+    const double f = (fm->F2 - fm->F) / fm->m - fm->a_a, beta = 0.5 * fm->c_s / fm->m, w2 = fm->k_s / fm->m;
+    const double y = fm->x - fm->anchor, y_rate = fm->v - fm->anchor_v;
+    double y_end, y_rate_end;
+    if (w2 > 0.0) { /* about the equilibrium f/w2 */
+        const double z = y - f / w2;
+        double eC, eS;
+        damped(beta, w2, H, &eC, &eS);
+        y_end = f / w2 + z * eC + (y_rate + beta * z) * eS;
+        y_rate_end = y_rate * eC - (w2 * z + beta * y_rate) * eS;
+    } else if (beta > 0.0) { /* a damper alone: the rate relaxes to the terminal f/(2 beta) */
+        const double terminal = f / (2.0 * beta), decay = -expm1(-2.0 * beta * H);
+        y_end = y + terminal * H + (y_rate - terminal) * decay / (2.0 * beta);
+        y_rate_end = terminal + (y_rate - terminal) * (1.0 - decay);
+    } else {
+        y_end = y + H * (y_rate + 0.5 * H * f);
+        y_rate_end = y_rate + H * f;
+    }
+    /* In the frame of the anchor m y'' y' = m f y' - k_s y y' - c_s y'^2 (f with the frame's force -m a_a):
+     * the damper's work over the step is exact from the step's ends. */
+    fm->E_diss += fm->m * f * (y_end - y)
+                  - 0.5 * fm->m * (y_rate_end * y_rate_end - y_rate * y_rate) - 0.5 * fm->k_s * (y_end * y_end - y * y);
+    fm->anchor += H * (fm->anchor_v + 0.5 * H * fm->a_a);
+    fm->anchor_v += H * fm->a_a;
+    fm->x = fm->anchor + y_end;
+    fm->v = fm->anchor_v + y_rate_end;
+    fm->t = t + H;
+    update_outputs(fm);
+    return FM_OK;
+}
+
+double fm_time(const fmu_model *fm)
+{
+    return fm->t;
+}
+
+#define F(field) {offsetof(fmu_model, field), FIELD_F64}
+
+static const state_field state_fields[] = {F(F), F(F2), F(x_a), F(v_a), F(a_a), F(anchor_v), F(m), F(k_s), F(c_s),
+                                           F(v0), F(x),  F(v),   F(t),    F(anchor), F(E_diss),
+                                           {offsetof(fmu_model, started), FIELD_I32}};
+
+#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
+
+size_t fm_state_size(const fmu_model *fm)
+{
+    (void)fm;
+    return fmu_fields_size(state_fields, N_STATE_FIELDS);
+}
+
+void fm_state_write(const fmu_model *fm, unsigned char *bytes)
+{
+    fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
+}
+
+fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
+{
+    fmu_model trial = *fm;
+    if (size != fm_state_size(fm))
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
+    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
+    if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
+        || rule_broken(VR_k_s, trial.k_s) || rule_broken(VR_c_s, trial.c_s)
+        || (trial.started != 0 && trial.started != 1))
+        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
+    *fm = trial;
+    update_outputs(fm);
+    return FM_OK;
+}

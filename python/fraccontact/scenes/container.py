@@ -1,0 +1,66 @@
+"""A scene's SSP as one container FMU, built by fmu-manipulation-toolbox
+(PyPI) and run by fmpy.
+
+The toolbox reads the SSP's SSD (components, connections) but not its
+parameter bindings, nor does it expose anything an SSD does not connect to
+the system's boundary: the components' values (the SSV files') become the
+container's start values, and the recorded variables its outputs. Its
+container steps every embedded FMU from the values of the last internal step
+(not sequential: a Jacobi master), with the internal step H.
+"""
+
+import contextlib
+import logging
+import pathlib
+import shutil
+import sys
+import tempfile
+
+from fmpy import simulate_fmu
+from fmpy.ssp.ssd import find_components, read_ssd
+
+
+def instance_names(ssp):
+    """{SSD component: the toolbox's name of its FMU}: the FMU's file in the
+    SSP's extract folder, numbered from its second instance on."""
+    from fmu_manipulation_toolbox.assembly import instance_name
+    used, names = [], {}
+    for component in find_components(read_ssd(str(ssp)).system):
+        name = instance_name(f"{ssp.stem}.dir/{pathlib.Path(component.source).name}", used)
+        used.append(name)
+        names[component.name] = name
+    return names
+
+
+def build(ssp, H, start, outputs, folder):
+    """The container FMU of ssp in folder (its path): internal step H [s],
+    start values start ({component: {variable: value}}), outputs the
+    recorded "component.variable" names."""
+    from fmu_manipulation_toolbox.assembly import Assembly
+    # It reports the inputs the SSD leaves unconnected (the masses, the rigid barrier's v2) as errors: they
+    # are set by the start values.
+    logging.getLogger("fmu_manipulation_toolbox").setLevel(logging.CRITICAL)
+    folder = pathlib.Path(folder)
+    shutil.copy(ssp, folder / ssp.name)
+    names = instance_names(ssp)
+    assembly = Assembly(ssp.name, fmu_directory=folder, default_step_size=H)
+    for component, values in start.items():
+        for variable, value in values.items():
+            assembly.root.add_start_value(names[component], variable, str(value))
+    for output in outputs:
+        component, variable = output.split(".")
+        assembly.root.add_output(names[component], variable, output)
+    assembly.make_fmu()
+    return folder / f"{ssp.stem}.fmu"
+
+
+def simulate(ssp, H, t_end, start, outputs):
+    """{output: values at 0, H, ..., t_end} of the container run by fmpy at
+    communication step H."""
+    with tempfile.TemporaryDirectory() as folder:
+        fmu = build(pathlib.Path(ssp), H, start, outputs, folder)
+        # fmpy prints the container's log (its mode, its solver's setup) on stdout, which is the
+        # command's: to stderr. (A logger of our own would outlive the call in fmpy's proxy.)
+        with contextlib.redirect_stdout(sys.stderr):
+            rows = simulate_fmu(str(fmu), stop_time=t_end, step_size=H, output_interval=H, output=list(outputs))
+    return {name: rows[name].astype(float) for name in outputs}

@@ -1,0 +1,35 @@
+# build/headform.ssp and build/bumper.ssp: the crash scenes (issue 25) as SSP
+# 1.0, their SSD from ssp/ and their SSV files written from
+# fraccontact/scenes/parameters.py by fraccontact.scenes.systems, with the
+# FMUs of this build. (Not in the Python package: it ships drop_test.ssp.)
+set(scene_ssvs "${CMAKE_BINARY_DIR}/scenes_ssv")
+file(GLOB scene_python "${CMAKE_SOURCE_DIR}/python/fraccontact/scenes/*.py")
+add_custom_command(OUTPUT "${scene_ssvs}/stamp"
+  COMMAND "${CMAKE_COMMAND}" -E rm -rf "${scene_ssvs}"
+  COMMAND "${CMAKE_COMMAND}" -E env "PYTHONPATH=${CMAKE_SOURCE_DIR}/python"
+          "FRACCONTACT_LIBRARY=$<TARGET_FILE:fraccontact_shared>"
+          "${Python3_EXECUTABLE}" -m fraccontact.scenes.systems "${scene_ssvs}"
+  COMMAND "${CMAKE_COMMAND}" -E touch "${scene_ssvs}/stamp"
+  DEPENDS ${scene_python} fraccontact_shared
+  COMMENT "Writing the scenes' SSV files")
+# One target runs it: two targets depending on one custom command's output would run it twice, at once.
+add_custom_target(scene_ssvs DEPENDS "${scene_ssvs}/stamp")
+foreach(scene headform bumper)
+  set(ssp_file "${CMAKE_BINARY_DIR}/${scene}.ssp")
+  set(staging "${CMAKE_BINARY_DIR}/${scene}.ssp.d")
+  add_custom_command(OUTPUT "${ssp_file}"
+    COMMAND "${CMAKE_COMMAND}" -E rm -rf "${staging}"
+    COMMAND "${CMAKE_COMMAND}" -E make_directory "${staging}/resources"
+    COMMAND "${CMAKE_COMMAND}" -E copy "${CMAKE_SOURCE_DIR}/ssp/${scene}.ssd" "${staging}/SystemStructure.ssd"
+    COMMAND "${CMAKE_COMMAND}" -E copy "${CMAKE_BINARY_DIR}/fraccontact.fmu" "${CMAKE_BINARY_DIR}/body.fmu"
+            "${staging}/resources/"
+    COMMAND sh -c "cp '${scene_ssvs}'/${scene}_*.ssv '${staging}/resources/'"
+    COMMAND "${CMAKE_COMMAND}" -E rm -f "${ssp_file}"
+    COMMAND "${CMAKE_COMMAND}" -E chdir "${staging}"
+            "${CMAKE_COMMAND}" -E tar cf "${ssp_file}" --format=zip SystemStructure.ssd resources
+    DEPENDS "${CMAKE_SOURCE_DIR}/ssp/${scene}.ssd" "${scene_ssvs}/stamp" "${CMAKE_BINARY_DIR}/fraccontact.fmu"
+            "${CMAKE_BINARY_DIR}/body.fmu"
+    COMMENT "Packaging ${scene}.ssp")
+  add_custom_target(${scene}_ssp ALL DEPENDS "${ssp_file}")
+  add_dependencies(${scene}_ssp fraccontact_fmu body_fmu scene_ssvs)
+endforeach()
