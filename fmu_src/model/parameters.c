@@ -52,11 +52,12 @@ double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s
  * more digits only where the double needs them to read back the same. */
 const char *shown(double value, char text[32])
 {
+    char digits_of[32]; /* formatted here: GCC's sanitizer build cannot see that text is never null */
     int digits = 6;
     do
-        snprintf(text, 32, "%.*g", digits, value);
-    while (strtod(text, NULL) != value && value == value && ++digits <= 17);
-    return text;
+        snprintf(digits_of, sizeof digits_of, "%.*g", digits, value);
+    while (strtod(digits_of, NULL) != value && value == value && ++digits <= 17);
+    return memcpy(text, digits_of, sizeof digits_of);
 }
 
 int contact_reject(char *msg, size_t len, const char *name, double value, const char *rule)
