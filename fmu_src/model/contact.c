@@ -485,6 +485,7 @@ void contact_configure(contact_model *cm, const contact_params *p)
     cm->peak_length = 0.0;
     cm->modes.modes = 0;
     cm->modes.h = 0.0;
+    cm->modes.trial_key[1] = 0.0;
     if (compressed_memory(cm))
         cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p),
                                      CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, cm->modes.a, cm->modes.b,
@@ -918,14 +919,38 @@ static void esdirk_trial_rates(const contact_model *cm, const contact_state *tri
     z[ESDIRK_STAGES - 1] = trial->x2_rate;
 }
 
+/* What identifies an ESDIRK trial from the model's state: its start time,
+ * its length and its stage rates. */
+static void esdirk_trial_key(const contact_model *cm, const contact_state *trial, double key[ESDIRK_STAGES + 2])
+{
+    key[0] = cm->s.t;
+    key[1] = trial->step;
+    esdirk_trial_rates(cm, trial, key + 2);
+}
+
+/* Keeps the end modes of the trial just taken from the model's state. */
+static void esdirk_keep_trial(contact_model *cm, const contact_state *trial, const esdirk_memory *mem)
+{
+    esdirk_trial_key(cm, trial, cm->modes.trial_key);
+    memcpy(cm->modes.trial_end, mem->phi[ESDIRK_STAGES - 1], cm->modes.modes * sizeof cm->modes.phi[0]);
+}
+
 /* The modes after an accepted ESDIRK step from the model's state: the last
- * stage's (stiffly accurate), recomputed from the trial's stage rates, so
- * that whichever of an event search's trials is accepted brings its own. */
+ * stage's (stiffly accurate). Those of the last trial taken when it is the
+ * one accepted (the same rates from the same modes: the same bits), else
+ * recomputed from the trial's stage rates, so that whichever of an event
+ * search's trials is accepted brings its own. */
 static void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
 {
     esdirk_memory mem;
-    double z[ESDIRK_STAGES];
+    double z[ESDIRK_STAGES], key[ESDIRK_STAGES + 2];
     int i;
+    esdirk_trial_key(cm, trial, key);
+    if (memcmp(key, cm->modes.trial_key, sizeof key) == 0) {
+        memcpy(cm->modes.phi, cm->modes.trial_end, cm->modes.modes * sizeof cm->modes.phi[0]);
+        cm->modes.trial_key[1] = 0.0;
+        return;
+    }
     esdirk_trial_rates(cm, trial, z);
     esdirk_memory_begin(cm, trial->step, &mem);
     for (i = 1; i < ESDIRK_STAGES; i++) {
@@ -1038,7 +1063,10 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
 static double springpot_esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
     esdirk_memory mem;
-    return esdirk_step_of(cm, in, h, K, out, &mem);
+    const double J = esdirk_step_of(cm, in, h, K, out, &mem);
+    if (in == &cm->s)
+        esdirk_keep_trial(cm, out, &mem);
+    return J;
 }
 
 /* An error-controlled step: the dashpot's, or the compressed springpot's
@@ -1977,6 +2005,7 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->h = f->h;
     t->sum_p = f->sum_p;
     t->sum_q = f->sum_q;
+    t->trial_key[1] = 0.0; /* the last trial's modes are not copied */
     memcpy(t->a, f->a, bytes);
     memcpy(t->b, f->b, bytes);
     memcpy(t->phi, f->phi, bytes);
