@@ -878,11 +878,15 @@ static double esdirk_memory_pull(const contact_model *cm, double h, int i, const
     int k;
     for (k = 0; k < i; k++)
         Z += esdirk_a[i][k] * z[k];
+    /* the stages' sum a_ik phi_k first, a stage at a time over the modes
+     * (contiguous: vectorised), then E_i and the pull */
+    for (j = 0; j < m->modes; j++)
+        mem->phi[i][j] = esdirk_a[i][0] * mem->phi[0][j];
+    for (k = 1; k < i; k++)
+        for (j = 0; j < m->modes; j++)
+            mem->phi[i][j] += esdirk_a[i][k] * mem->phi[k][j];
     for (j = 0; j < m->modes; j++) {
-        double past = 0.0, E;
-        for (k = 0; k < i; k++)
-            past += esdirk_a[i][k] * mem->phi[k][j];
-        E = mem->phi[0][j] + h * (Z - m->b[j] * past);
+        const double E = mem->phi[0][j] + h * (Z - m->b[j] * mem->phi[i][j]);
         mem->phi[i][j] = E;
         A += m->a[j] * mem->d[j] * E;
     }
