@@ -72,7 +72,7 @@ int anchor_impact(const anchor_problem *p, anchor_result *r)
 {
     anchor_ode o = {p->k, 1.0 / p->c, 1.0 / p->m, 0};
     gsl_odeiv2_system sys = {anchor_rhs, NULL, 3, &o};
-    /* The elastic Hertz impact's largest indentation (MODEL.md §2) and its
+    /* The elastic Hertz impact's largest indentation (docs/model.md §2) and its
      * time scale: the contact lasts 2.94 of them without the dashpot. */
     double x_hertz = pow(5.0 * p->m * p->v0 * p->v0 / (4.0 * p->k), 0.4), t_scale = x_hertz / p->v0;
     /* An absolute error per component, rtol times its scale (x_hertz for the

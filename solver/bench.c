@@ -1,5 +1,5 @@
-/* fraccontact-bench: timings for docs/benchmarks.md (scripts/benchmarks.py
- * runs it; not a test). Prints one JSON object.
+/* fraccontact-bench: timings for docs/benchmarks.md
+ * (python/fraccontact/reports/benchmarks.py runs it; not a test). Prints one JSON object.
  *   fraccontact-bench step           ns per internal step of each law, and of
  *                                     the literal O(N) G1 sum per step
  *   fraccontact-bench g1 N ALPHA      the bare G1 history sum of f(x) = x on
@@ -101,7 +101,7 @@ static int bench_step(void)
     return 0;
 }
 
-/* The G1 value of D^alpha x at grid point n (MODEL.md §4 closed form), and
+/* The G1 value of D^alpha x at grid point n (docs/model.md §4 closed form), and
  * the magnitude of the terms it sums (for f >= 0 all weights share a sign
  * when alpha < 0; for 0 < alpha < 1 all but w_0 are negative). */
 static double line_value(double alpha, size_t n, double delta)

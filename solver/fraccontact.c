@@ -184,7 +184,14 @@ int fc_error_controlled(const fc_params *p)
     return contact_error_controlled(&q);
 }
 
-/* t_c v / x_max of an elastic impact on the spring k x1^n (MODEL.md §2):
+const char *fc_method_name(const fc_params *p)
+{
+    contact_params q;
+    fc_model_params(p, &q);
+    return contact_method_name(contact_method(&q));
+}
+
+/* t_c v / x_max of an elastic impact on the spring k x1^n (docs/model.md §2):
  * 2 integral_0^1 (1 - u^(n+1))^(-1/2) du = 2/(n+1) B(1/(n+1), 1/2). */
 static double elastic_contact_time(double n)
 {
@@ -349,7 +356,7 @@ static void watch_run(watch *w, contact_model *cm)
     w->cm = cm;
     w->counted = 0;
     w->unit = contact_error_controlled(&cm->p) ? CONTROLLED_STEP_UNITS : 1;
-    w->history = cm->p.damper == CONTACT_DAMPER_SPRINGPOT && cm->p.memory == CONTACT_MEMORY_G1;
+    w->history = contact_method(&cm->p) == CONTACT_METHOD_G1_HISTORY;
     if (w->report) {
         cm->poll = poll_run;
         cm->poll_ctx = w;
@@ -425,7 +432,7 @@ static void keep_rows_until(series *out, const contact_model *from, double t, do
  * rows are the grid points at or just after the output times. */
 static int rows_on_grid(const contact_params *q)
 {
-    return q->damper == CONTACT_DAMPER_SPRINGPOT && q->memory == CONTACT_MEMORY_G1;
+    return contact_method(q) == CONTACT_METHOD_G1_HISTORY;
 }
 
 static void keep_grid_rows_until(series *out, const contact_model *cm, double interval, int64_t *k)

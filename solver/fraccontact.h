@@ -1,4 +1,4 @@
-/* libfraccontact: the contact model of MODEL.md as a C library, for the
+/* libfraccontact: the contact model of docs/model.md as a C library, for the
  * solver CLI, the benchmarks and the Python package (GSL's odeiv2 style: a
  * parameter struct with defaults from one function, status codes, no global
  * state). The same model code as the FMU; no GSL, libc and libm only.
@@ -71,12 +71,12 @@ typedef struct {
     int g1_nodes;    /* G1 intervals N; 0: internal steps since contact onset */
     int scene;       /* 1 drop test, 2 driven */
     int scheme;      /* 1 SDIRK2 (implicit, L-stable), 2 the paper's central differences */
-    int damper;      /* 1 dashpot, 2 springpot (MODEL.md §7) */
-    int memory;      /* the springpot's memory: 1 full G1 history, 2 compressed (MODEL.md §8) */
+    int damper;      /* 1 dashpot, 2 springpot (docs/model.md §5) */
+    int memory;      /* the springpot's memory: 1 full G1 history, 2 compressed (docs/model.md §6) */
     int impacts;     /* stop right after this many impacts have ended */
 } fc_params;
 
-/* The paper's h20 drop test (MODEL.md §6): v = sqrt(2 9.81 0.020), m =
+/* The paper's h20 drop test (docs/model.md §1): v = sqrt(2 9.81 0.020), m =
  * 0.7437, k = 3.299e8, c = 6080, dt_max = 0 (fixed steps of 1e-7 s), G1 law; one impact, t_end 1 s. */
 FC_API void fc_params_default(fc_params *p);
 
@@ -94,6 +94,10 @@ FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 /* 1 when the run chooses its steps by p->tolerance (Kvaerno's ESDIRK 5(4)),
  * 0 when it takes fixed steps of dt_max. */
 FC_API int fc_error_controlled(const fc_params *p);
+
+/* The method the run takes, as the model names it (contact_method_name):
+ * "sdirk2", "esdirk54", "g1_history" or "central". */
+FC_API const char *fc_method_name(const fc_params *p);
 
 /* The largest internal step of these parameters [s]: dt_max, or for
  * dt_max = 0 the fixed step of 1e-7 s, or INFINITY where error-controlled
@@ -141,7 +145,7 @@ typedef struct {
     double t;        /* where the run stopped [s] */
     double x, x1, x2;/* total, elastic and permanent indentation there [m] */
     double v;        /* striker velocity there [m/s] */
-    double k;        /* the Hertz constant used (given, or derived) [N/m^1.5] */
+    double k;        /* the spring constant used (given, or derived) [N/m^n] */
 } fc_outcome;
 
 /* Columns of a row of the time series. */
@@ -220,7 +224,7 @@ FC_API fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, f
                                             fc_batch_progress progress, void *ctx);
 
 /* The compressed memory's kernel for the parameters' damper_order,
- * memory_tolerance and dt_max (MODEL.md §8): tau^(-alpha)/Gamma(1-alpha) ~
+ * memory_tolerance and dt_max (docs/model.md §6): tau^(-alpha)/Gamma(1-alpha) ~
  * eta delta(tau) + sum_i a_i exp(-b_i tau), the last term the lumped spring
  * (b = 0). Writes up to `max` terms and *eta; returns their number M (more
  * than max: none written), or 0 with a message when the parameters fail

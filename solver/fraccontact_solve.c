@@ -146,7 +146,7 @@ static void usage(const option_table *t)
     size_t i;
     printf("usage: " PROGRAM " [OPTION VALUE]... [--json] [--reference]\n"
            "Simulates an impact on a Hertz spring in series with a dashpot, the spring force\n"
-           "computed by the G1 Grunwald-Letnikov semi-integral (MODEL.md). Defaults: the paper's\n"
+           "computed by the G1 Grunwald-Letnikov semi-integral (docs/model.md). Defaults: the paper's\n"
            "h20 drop test. Options take a value as '--opt VALUE' or '--opt=VALUE'; the model's\n"
            "options are the FMU's variables (--dt-max for dt_max).\n\n");
     for (i = 0; i < t->n; i++)
@@ -173,7 +173,7 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, esdirk5 (error-controlled steps, tolerance > 0), central, bdf2-g1 (a\n"
+           "  method, k    sdirk2, esdirk54 (error-controlled steps, tolerance > 0), central, g1_history (a\n"
            "               springpot's full G1 history) or reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed, 130 interrupted (Ctrl-C).\n"
@@ -504,11 +504,7 @@ static const char *method_name(const options *o)
 {
     if (o->reference)
         return "reference";
-    if (o->p.damper == 2 && o->p.memory == 1)
-        return "bdf2-g1"; /* the full G1 history's own scheme */
-    if (fc_error_controlled(&o->p))
-        return "esdirk5"; /* error-controlled steps: Kvaerno's ESDIRK 5(4) */
-    return o->p.scheme == 2 ? "central" : "sdirk2";
+    return fc_method_name(&o->p);
 }
 
 /* "name": value for each figure of an impact; null for a missing one. */
@@ -634,7 +630,7 @@ static void watch_start(progress_line *line, const options *o, const series *row
     line->o = o;
     line->rows = rows;
     line->shown = 0;
-    /* not otherwise: --repeat times the solve, and a clock read costs about 0.6 us */
+    /* not otherwise: --repeat times the solve, and a clock read would be in the timing */
     line->next = !o->quiet && !o->json && isatty(STDERR_FILENO) ? cpu_seconds() + PROGRESS_AFTER : 0.0;
 }
 

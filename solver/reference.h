@@ -1,4 +1,4 @@
-/* The high-accuracy reference: the contact ODE of MODEL.md §2 solved with
+/* The high-accuracy reference: the contact ODE of docs/model.md §2 solved with
  * GSL's odeiv2 (adaptive Runge-Kutta-Prince-Dormand 8(9), or the implicit
  * multistep BDF where the dashpot makes the problem stiff), with contact
  * onset, the force peak and separation located by root finding. It solves

@@ -1,4 +1,4 @@
-/* fraccontact-soak: scale and endurance of the FMU (scripts/reliability.py
+/* fraccontact-soak: scale and endurance of the FMU (python/fraccontact/reports/reliability.py
  * runs it for docs/reliability.md; not a test). Prints one JSON object.
  *   fraccontact-soak instances N      N instances alive at once, each through an impact
  *   fraccontact-soak threads T        T threads stepping their own instances at once,

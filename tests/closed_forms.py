@@ -1,5 +1,5 @@
 """What the tests compare with, computed here and not by the C code: the
-closed forms of MODEL.md and the accuracy measured for the scheme."""
+closed forms of docs/model.md and the accuracy measured for the scheme."""
 
 import math
 from fractions import Fraction
@@ -7,10 +7,9 @@ from fractions import Fraction
 EPS = 2.0 ** -52  # machine epsilon, the ulp of 1.0 (twice the unit roundoff)
 GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
 
-# The elastic Hertz contact time (MODEL.md §2): t_c = 2 (x_max/v0) ∫₀¹ (1 − u^(5/2))^(−1/2) du;
+# The elastic Hertz contact time (docs/model.md §2): t_c = 2 (x_max/v0) ∫₀¹ (1 − u^(5/2))^(−1/2) du;
 # with w = u^(5/2) the integral is (2/5) B(2/5, 1/2), so t_c = (4/5) B(2/5, 1/2) x_max/v0
-# (2.9432751843247...; MODEL.md's 2.94327 is that truncated, 1.8e-6 too small;
-# test_fmu_physics.py checks the integral by quadrature).
+# (2.9432751843247...; tests/test_fmu_physics.py checks the integral by quadrature).
 HERTZ_TC = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
 
 # What the drop test's results may differ from a converged solve of the same
@@ -24,7 +23,7 @@ _RATIONAL = [None, Fraction(1)]
 
 
 def g1_line_ratio(N):
-    """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), MODEL.md §4, to a few ulp.
+    """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), docs/model.md §4, to a few ulp.
 
     Gamma(N + 3/2) / (Gamma(5/2) Gamma(N)) = prod_{j=1}^{N-1} (j + 3/2) / j
     is rational: Python's Fraction keeps it exact and float() rounds it once;
@@ -51,5 +50,5 @@ def extrapolated_ratio(N):
 
 
 def hertz_k(R, E_i, nu_i, E_s, nu_s):
-    """MODEL.md §2: k = (4/3) E* sqrt(R), 1/E* = (1 - nu_i^2)/E_i + (1 - nu_s^2)/E_s."""
+    """docs/model.md §2: k = (4/3) E* sqrt(R), 1/E* = (1 - nu_i^2)/E_i + (1 - nu_s^2)/E_s."""
     return 4.0 / 3.0 * math.sqrt(R) / ((1 - nu_i ** 2) / E_i + (1 - nu_s ** 2) / E_s)

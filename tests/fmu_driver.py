@@ -5,7 +5,7 @@ import math
 
 from fraccontact.fmu import Slave  # noqa: F401  (the tests' driver)
 
-# The paper's h20 test (MODEL.md §1, §6).
+# The paper's h20 test (docs/model.md §1).
 G = 9.81
 V0 = math.sqrt(2 * G * 0.020)
 M = 0.7437

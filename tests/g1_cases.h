@@ -13,7 +13,7 @@
  * (1986) 704):
  *     G1 - D^alpha f = C1(t) h + Cb(t) h^(p+1) + O(h^2),
  *     C1 = -(alpha/2) D^(alpha+1) f   (the smooth part: for f = t,
- *          alpha = -1/2 it is the 3/(8N) of MODEL.md §4),
+ *          alpha = -1/2 it is the 3/(8N) of docs/model.md §4),
  *     Cb = (zeta(-p) + [p = 0]) t^(-alpha-1) / Gamma(-alpha)   (the start:
  *          for alpha = -1 the rectangle rule's Euler-Maclaurin/zeta term).
  * f = t^p: D^alpha t^p = Gamma(p+1)/Gamma(p+1-alpha) t^(p-alpha); C1 vanishes

@@ -155,7 +155,7 @@ def test_words_mixed_with_codes_in_one_array():
 # --- item 24: one shape of result ------------------------------------------
 
 RUN_FIELDS = ["t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss", "per_impact", "end",
-              "stopped", "impacts", "steps", "k"]
+              "stopped", "impacts", "steps", "k", "method"]
 END_FIELDS = ["t", "F_peak", "eps", "t_contact", "E_diss", "x", "x1", "x2", "v"]
 SERIES_FIELDS = ["t", "F", "x", "x1", "x2", "v", "E_diss", "run"]
 
@@ -199,7 +199,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def readme_python_section():
-    text = open(os.path.join(ROOT, "README.md")).read()
+    text = open(os.path.join(ROOT, "docs", "python.md")).read()
     return text.split("## In Python: the `fraccontact` package", 1)[1].split("\n## ", 1)[0]
 
 

@@ -1,5 +1,6 @@
-"""The README's figures, measured (issue 23, items 27 to 30). Each test finds
-its sentence in README.md, reads the figure as written there, and measures it
+"""The figures of the README and the guides of docs/ (tests/doc_pages.py),
+measured (issue 23, items 27 to 30). Each test finds its sentence on
+whichever page holds it, reads the figure as written there, and measures it
 on this build: a figure that drifts, or a sentence reworded without its test,
 fails here. Figures are compared at the precision they are stated with:
 "within X" and "up to X" are bounds, held within a decade (a bound ten times
@@ -24,18 +25,19 @@ pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
 from fmpy import simulate_fmu
 
 import fraccontact
+from doc_pages import prose, section
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-README = " ".join((ROOT / "README.md").read_text().split())  # sentences as one line each
+PROSE = prose()  # every page's sentences, as one line each
 FMU = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
 SOLVE = os.environ.get("FRACCONTACT_SOLVE", str(ROOT / "build" / "fraccontact-solve"))
 FIGURES = ("F_peak", "eps", "x2", "E_diss")
 
 
 def claim(pattern):
-    """The README's match of pattern (whitespace as one space): its groups."""
-    m = re.search(pattern, README)
-    assert m, f"README.md no longer says {pattern!r}: update the sentence's test with it"
+    """The pages' match of pattern (whitespace as one space): its groups."""
+    m = re.search(pattern, PROSE)
+    assert m, f"no page says {pattern!r} any more: update the sentence's test with it"
     return m.groups()
 
 
@@ -87,7 +89,7 @@ def test_alpha_1_is_the_dashpot_as_the_readme_says(law):
     every communication point of the impact; x2, E_diss within the README's
     rounding bound; over nine bounces under gravity eps, x2, E_diss within
     its second bound. Independent of either damper's code: the two runs are
-    different arithmetic of one model, and MODEL.md §7's springpot at
+    different arithmetic of one model, and docs/model.md §5's springpot at
     alpha = 1 is the dashpot."""
     (first,) = claim(r"`x2` and `E_diss` differ by rounding, within (\S+) over an impact")
     stop, impacts, later = claim(r"bouncing under gravity \((\S+) s, (\w+) impacts\), eps, x2 and E_diss stay within (\S+) of")
@@ -148,7 +150,7 @@ def test_with_a_gap_the_figures_move_within_the_laws_error():
     library, which steps dt_max from the onset."""
     (hertz,) = claim(r"by up to (\S+) with the closed-form Hertz law")
     (g1,) = claim(r"by up to (\S+) with the G1 law \(`law = 1`\)")
-    assert "they differ from the library's as much" in README
+    assert "they differ from the library's as much" in PROSE
     for law, stated in ((2, hertz), (1, g1)):
         at = [figures_at(H, law, gap0=1e-3) for H in INTERVALS]
         assert_bound(spread(at), number(stated), f"law {law}, gap0 = 1e-3, across intervals")
@@ -157,7 +159,7 @@ def test_with_a_gap_the_figures_move_within_the_laws_error():
 
 
 def test_an_interval_off_the_grid_of_dt_max_moves_the_figures_by_the_laws_error():
-    H, hertz, g1 = claim(r"at (\S+) s \(steps of \S+ s\) the figures of the drop test above move from those at "
+    H, hertz, g1 = claim(r"at (\S+) s \(steps of \S+ s\) the figures of the default drop test move from those at "
                          r"1e-5 s by (\S+) with law 2, and by (\S+) with law 1")
     for law, stated in ((2, hertz), (1, g1)):
         moved = spread([figures_at(number(H), law), figures_at(1e-5, law)])
@@ -181,14 +183,6 @@ def test_a_masters_step_computed_from_its_clock_cuts_no_extra_internal_step(slav
 
 
 # --- item 30: stale figures ---------------------------------------------------------
-
-README_LINES = (ROOT / "README.md").read_text()
-
-
-def section(heading):
-    """The README's text under a '## heading' (to the next one), lines kept."""
-    return README_LINES.split(f"\n## {heading}", 1)[1].split("\n## ", 1)[0]
-
 
 def table_rows(text, first_cell):
     """Cells of the markdown table rows whose first cell contains first_cell."""
@@ -255,7 +249,8 @@ def test_the_number_of_modes():
 
 
 def variable_table_row(name):
-    [row] = [line for line in README_LINES.splitlines() if line.startswith(f"| `{name}` |")]
+    """The row of docs/variables.md's 'What each variable does'."""
+    [row] = [line for line in section("What each variable does").splitlines() if line.startswith(f"| `{name}` |")]
     return row
 
 
@@ -303,7 +298,7 @@ def test_the_docs_list_quotes_its_reports(bullet):
     """Each figure of the README's summary of a report is one the report
     states, at the README's digits (a weak check: a small integer may match
     an unrelated one, but a stale figure rarely survives it)."""
-    report = (ROOT / "docs" / re.search(r"\(docs/(\w+\.md)\)", bullet).group(1)).read_text()
+    report = (ROOT / "docs" / re.search(r"`docs/(\w+\.md)`", bullet).group(1)).read_text()
     there = {value(n) for n in numbers_in(report)}
     missing = [n for n in numbers_in(" ".join(bullet.split()))
                if value(n) != 0 and not any(y != 0 and float(f"{y:.{stated_digits(n) - 1}e}") == value(n) for y in there)]
@@ -314,14 +309,14 @@ def test_parameters_lists_what_the_readme_says():
     """'In Python': the names fraccontact.parameters() lists, and height beside them."""
     (listed,) = claim(r"named as the FMU's variables \((.*?), which `fraccontact.parameters\(\)` lists")
     assert set(re.findall(r"`(\w+)`", listed)) == {p["name"] for p in fraccontact.parameters()}
-    assert "and `height`, the drop height [m] that sets `v`" in README
+    assert "and `height`, the drop height [m] that sets `v`" in PROSE
     assert fraccontact.impact(height=0.02).F_peak == fraccontact.impact(v=fraccontact.drop_velocity(0.02)).F_peak
 
 
 def test_sweep_json_holds_statistics_for_monte_carlo_only(tmp_path):
     """The README: counts and throughput, statistics for a Monte Carlo campaign
     (tests/test_sweep.py checks those statistics against numpy)."""
-    assert "`sweep/sweep.json` (for a Monte Carlo campaign also the mean, standard deviation" in README
+    assert "`sweep/sweep.json` (for a Monte Carlo campaign also the mean, standard deviation" in PROSE
     from fraccontact import sweep
     assert sweep.main(["--vary", "c=3000,6080", "--set", "law=hertz", "--workers", "1", "--out", str(tmp_path)]) in (0, None)
     assert "statistics" not in json.loads((tmp_path / "sweep.json").read_text())
@@ -355,6 +350,14 @@ def test_the_readme_fit_commands_print_what_they_say(command, shown, tmp_path):
     printed = [line.rstrip() for line in run.stdout.splitlines()]
     for line in shown:
         assert any(p.startswith(line) for p in printed), f"{line!r} not in:\n{run.stdout}"
+
+
+def test_the_readmes_fit_commands_are_the_guides():
+    """The README's fit commands are among docs/fitting.md's, which the test above runs."""
+    shown = {c for c, _ in fit_commands()}
+    readme = [" ".join(line.split()) for block in re.findall(r"```sh\n(.*?)```", section("Calibration"), re.S)
+              for line in block.splitlines() if line.startswith("fraccontact fit")]
+    assert readme and set(readme) <= shown, set(readme) - shown
 
 
 def load_make_examples():

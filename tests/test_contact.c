@@ -10,7 +10,7 @@
 
 static const double V0 = 0.626418, M = 0.7437; /* the paper's h20 drop */
 
-/* The elastic Hertz contact time t_c = HERTZ_TC x_max / v0 (MODEL.md §2):
+/* The elastic Hertz contact time t_c = HERTZ_TC x_max / v0 (docs/model.md §2):
  * 2 int_0^1 (1 - u^(5/2))^(-1/2) du, which u^(5/2) = w turns into a beta
  * function, 2 sqrt(pi) Gamma(7/5) / Gamma(9/10) = 2.9432692... */
 static double hertz_tc_factor(void)
@@ -26,7 +26,8 @@ static double hertz_contact_time(double k)
 /* Rounding: a step rounds each of v, x1, x2 and E_diss once or twice by at
  * most half an ulp of the value, and an energy doubles the velocity's
  * relative error: 4 ulp per step bounds what rounding alone accumulates,
- * relative to the figure's scale (scripts/stability.py, ROUNDING_ULPS). */
+ * relative to the figure's scale (python/fraccontact/reports/stability/core.py,
+ * ROUNDING_ULPS). */
 static double rounding(int64_t steps)
 {
     return 4.0 * DBL_EPSILON * (double)(steps + 4);
@@ -121,7 +122,7 @@ static void test_second_order(void)
     }
 }
 
-/* The elastic limit (c -> infinity): Hertz impact, MODEL.md §2. The
+/* The elastic limit (c -> infinity): Hertz impact, docs/model.md §2. The
  * scheme's errors, measured at dt = 1e-7 (h = dt/t_c = 8.1e-5): F_peak
  * -0.16 h^2 (allowed 0.3 h^2), the contact time +0.50 h^2 (allowed 1.0 h^2,
  * against the exact constant), eps - 1 = +0.16 h^2.5: the energy SDIRK2
@@ -136,7 +137,8 @@ static void test_elastic_limit(void)
     CHECK(fabs(cm.s.eps - 1.0) <= 0.42 * pow(h, 2.5), "eps = %.15f, not 1 within %.3g", cm.s.eps, 0.42 * pow(h, 2.5));
 }
 
-/* Known findings (docs/stability.md, scripts/stability.py KNOWN): runs that
+/* Known findings (docs/stability.md,
+ * python/fraccontact/reports/stability/dashpot.py KNOWN): runs that
  * fail a check the model satisfies, because of the time scheme. They must
  * still fail (a fix shows up here: remove the entry); every other run must
  * pass. ENERGY: SDIRK2 gains energy in nearly elastic Hertz impacts, about

@@ -25,7 +25,7 @@ def test_mass_aware_gauss_seidel_is_the_monolithic_drop_test(reference, H):
     """The proxy striker is the striker and F_avg its exact impulse: with H
     a multiple of dt_max the runs agree to rounding, whatever the step."""
     r = cosimulate(CONTACT, STRIKER, H, "mass-aware", "gauss-seidel")
-    # the same internal steps: only rounding differs (measured 1e-14, README)
+    # the same internal steps: only rounding differs (measured 1e-14, docs/coupling.md)
     assert r["F_peak"] == pytest.approx(reference["F_peak"], rel=1e-12, abs=0)
     assert r["eps"] == pytest.approx(reference["eps"], rel=1e-12, abs=0)
     assert r["energy_error"] == pytest.approx(reference["energy_error"], rel=0, abs=1e-12)

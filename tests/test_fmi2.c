@@ -172,7 +172,7 @@ static void test_out_of_range(void)
 /* Two instances stepped alternately give, bit for bit, what each gives
  * alone: no shared state. */
 /* Free flight is one exact step, so a communication step of 1e9 s holds
- * the impact's steps and one more (README, "Sub-stepping"). The full G1
+ * the impact's steps and one more (docs/numerics.md, "Sub-stepping"). The full G1
  * history steps on a uniform grid of dt_max, so a step that needs more than
  * 1e9 of them is refused at once and changes nothing. */
 static void test_long_steps(void)

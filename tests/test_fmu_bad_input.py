@@ -123,7 +123,7 @@ def test_a_material_without_effect_warns_at_the_end_of_initialization(slave, nam
 def assert_stepping_matches_the_default(s):
     for _ in range(200):
         s.step(1e-5)
-    assert s.get("eps") == pytest.approx(0.58606378, rel=1e-7, abs=0)  # the h20 default (README)
+    assert s.get("eps") == pytest.approx(0.58606378, rel=1e-7, abs=0)  # the h20 default (README, "Two commands")
 
 
 # A damper's parameter set while the other damper is selected, and what

@@ -4,7 +4,7 @@ fall, the driven scene's proxy striker under gravity, the extrapolated G1
 law (law 3) at odd N, the force peak located inside a coarse step, the
 `contact` flag's transitions, and k derived from the materials.
 
-The references: closed forms (MODEL.md §2, §4; free fall), GSL's
+The references: closed forms (docs/model.md §2, §4; free fall), GSL's
 high-accuracy solve of the same ODE (`fraccontact-solve --reference`) and
 scipy (fraccontact/scipy_contact.py). Every approximate comparison states its
 absolute tolerance (usually 0) and where its relative one comes from."""
@@ -392,7 +392,7 @@ OTHER_MATERIALS = dict(R=5e-3, E_i=70e9, nu_i=0.33, E_s=1.2e9, nu_s=0.42)
 def test_k_zero_uses_every_material_parameter(slave, changed):
     """One material away from its default at a time (each changes k by
     2.8e-4, nu_i's share, or more: 1e9 times the tolerance), and all at
-    once: F = k x1^(3/2) with k from MODEL.md §2, to the rounding of
+    once: F = k x1^(3/2) with k from docs/model.md §2, to the rounding of
     x1 = v t (DRIVEN_RTOL). No warning: k = 0 uses them."""
     materials = dict(DEFAULT_MATERIALS)
     materials.update(OTHER_MATERIALS if changed == "all" else {changed: OTHER_MATERIALS[changed]})
@@ -407,7 +407,7 @@ def test_k_zero_uses_every_material_parameter(slave, changed):
 
 
 def test_k_from_materials_gives_the_hertz_impact(slave):
-    """The elastic limit (MODEL.md §2) with k derived from other materials,
+    """The elastic limit (docs/model.md §2) with k derived from other materials,
     another mass and speed: x_max = (5 m v0^2/(4k))^(2/5), F_max = k x_max^1.5,
     t_c = (4/5) B(2/5, 1/2) x_max / v0, eps = 1. At c = 1e15 the dashpot's
     share (~1/c: 2e-6 of F_peak at c = 1e9, too much) is ~1e-12, below the

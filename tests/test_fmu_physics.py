@@ -1,5 +1,5 @@
 """The force through the FMU against what is known independently of it:
-closed forms (MODEL.md §2-§4) and a high-accuracy solve of the same ODE
+closed forms (docs/model.md §2-§4) and a high-accuracy solve of the same ODE
 with scipy.
 
 Every approximate comparison states abs= (pytest's default absolute
@@ -35,7 +35,7 @@ def test_hertz_contact_time_constant_is_the_beta_function():
 
 @pytest.mark.parametrize("N", [1, 2, 7, 30, 333, 400, 1000])
 def test_rational_ratio_agrees_with_lgamma(N):
-    """Two routes to MODEL.md §4's ratio; lgamma's rounding is an ulp of
+    """Two routes to docs/model.md §4's ratio; lgamma's rounding is an ulp of
     each of its terms, ln Gamma(N + 3/2) ~ N ln N the largest."""
     by_lgamma = math.exp(math.lgamma(N + 1.5) - math.lgamma(N) - 1.5 * math.log(N))
     terms = abs(math.lgamma(N + 1.5)) + abs(math.lgamma(N)) + 1.5 * math.log(N) + 1
@@ -75,7 +75,7 @@ def test_driven_g1_law_has_the_straight_line_error(slave):
     for t, N, F, semi, x1 in rows:
         assert F == pytest.approx(K * (v * t) ** 1.5 * g1_line_ratio(N), rel=DRIVEN_RTOL, abs=0)
         assert semi == pytest.approx((v * t) ** 1.5 / GAMMA_5_2 * g1_line_ratio(N), rel=DRIVEN_RTOL, abs=0)
-    # The first-order error of MODEL.md §4, 1 + 3/(8N), with its next term:
+    # The first-order error of docs/model.md §4, 1 + 3/(8N), with its next term:
     # Gamma(N+a)/(Gamma(N) N^a) = 1 + a(a-1)/(2N) + a(a-1)(a-2)(3a-1)/(24N^2)
     # + a^2(a-1)^2(a-2)(a-3)/(48N^3) + ..., at a = 3/2: 3/(8N) - 21/(384N^2)
     # + (9/1024)/N^3. The bound is 3x that N^-3 term (2.6e-8 of 3/(8N) at
@@ -98,7 +98,7 @@ def test_k_zero_derives_k_from_the_materials(slave):
     for t, N, F, semi, x1 in rows:
         # and a few ulp between the C and the Python order of operations
         assert F == pytest.approx(k * (v * t) ** 1.5, rel=DRIVEN_RTOL, abs=0)
-    # MODEL.md §6: the paper's E_s = 2.64 GPa is consistent with its k. The
+    # docs/model.md §1: the paper's E_s = 2.64 GPa is consistent with its k. The
     # paper gives E_s to 3 digits, +-0.005/2.64 = 1.9e-3 relative, and k
     # moves with E_s nearly in proportion (measured: k/K - 1 = -1.4e-3).
     assert k == pytest.approx(K, rel=2e-3, abs=0)
@@ -107,7 +107,7 @@ def test_k_zero_derives_k_from_the_materials(slave):
 # --- drop test --------------------------------------------------------------
 
 def test_elastic_limit_matches_hertz_closed_forms(slave):
-    """c -> infinity: pure Hertz impact (MODEL.md §2). At c = 1e15 the dashpot
+    """c -> infinity: pure Hertz impact (docs/model.md §2). At c = 1e15 the dashpot
     changes F_peak by ~1e-12 and eps by ~3e-12 (both scale as 1/c: 2e-6 and
     3.4e-6 at c = 1e9), below the scheme's error."""
     s = slave(law=2, c=1e15)

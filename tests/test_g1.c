@@ -1,6 +1,6 @@
 /* The G1 operator against closed forms: powers t^p and exponentials e^(at)
  * (order of convergence and the predicted error terms), Richardson
- * extrapolation, and the straight-line identity of MODEL.md §4. */
+ * extrapolation, and the straight-line identity of docs/model.md §4. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -10,7 +10,7 @@
 #include "g1.h"
 #include "g1_cases.h"
 
-/* D^alpha t^q at t = 1 by the power rule (MODEL.md §3). */
+/* D^alpha t^q at t = 1 by the power rule (docs/model.md §3). */
 static double power_rule_at_1(double alpha, double q)
 {
     return tgamma(q + 1.0) / tgamma(q + 1.0 - alpha);
@@ -168,7 +168,7 @@ static void test_line_ratio(void)
         double reference = (double)expl(lgammal(n + a) - lgammal(n) - a * logl(n));
         CHECK_REL(g1_line_ratio(-0.5, (double)N), reference, 1e-14, "Gamma(N+3/2)/(Gamma(N) N^1.5)");
     }
-    CHECK_REL(g1_line_ratio(-0.5, 1.0), tgamma(2.5), 1e-15, "N = 1: the 33 % error of MODEL.md §4");
+    CHECK_REL(g1_line_ratio(-0.5, 1.0), tgamma(2.5), 1e-15, "N = 1: the 33 % error of docs/model.md §4");
     /* 1 + 3/(8N) + O(N^-2): at N = 1e6 the O(N^-2) rest is ~1e-13. */
     CHECK(fabs(g1_line_ratio(-0.5, 1e6) - (1.0 + 3.0 / 8e6)) < 1e-12, "expansion at N = 1e6: %.17g",
           g1_line_ratio(-0.5, 1e6));

@@ -1,7 +1,7 @@
 """Issue 23, the model's items, each held against something the code under
 test does not compute: GSL's reference (fraccontact-solve --reference),
 energy and momentum, the library's own monolithic run where the FMU must
-reproduce it, and the README's figures.
+reproduce it, and the figures of docs/numerics.md.
 
  5  memory = 1 past its history's limit: refused at setup, not after minutes
  10 a tiny striker: its impact resolved, no energy created
@@ -206,11 +206,11 @@ def test_tolerance_alone_chooses_the_steps():
     """`fraccontact-solve --law hertz --height 0.02 --tolerance 1e-6` took
     the 13 161 steps of 1e-7 s: dt_max = 1e-7 capped the error-controlled
     steps. dt_max = 0, the default, caps nothing now: a few dozen steps,
-    the figures within 15 times the tolerance of GSL's (README, "Error-
+    the figures within 15 times the tolerance of GSL's (docs/numerics.md, "Error-
     controlled steps")."""
     r = solve_json("--law", "hertz", "--height", 0.02, "--tolerance", 1e-6)
     ref = reference("--height", 0.02)
-    assert r["steps"] < 30 and r["method"] == "esdirk5"
+    assert r["steps"] < 30 and r["method"] == "esdirk54"
     for key in ("F_peak", "eps", "t_contact", "x2_end"):
         assert r[key] == pytest.approx(ref[key], rel=15e-6, abs=0), key
     assert fraccontact.impact(law="hertz", tolerance=1e-6).steps == r["steps"]
@@ -242,14 +242,14 @@ def test_tolerance_alone_makes_the_fmu_fast(slave):
     assert seconds(tolerance=1e-6) < seconds() / 10
 
 
-README = (ROOT / "README.md").read_text()
+NUMERICS = (ROOT / "docs" / "numerics.md").read_text()
 
 
 def test_the_readme_tolerance_table_is_what_tolerance_alone_gives():
-    """The README's table of internal steps and largest error against GSL
+    """docs/numerics.md's table of internal steps and largest error against GSL
     for the h20 impact at each tolerance, remeasured: steps exactly, the
     error to the two digits shown."""
-    lines = README.splitlines()
+    lines = NUMERICS.splitlines()
     top = next(i for i, line in enumerate(lines) if line.startswith("| `tolerance` | 1e-6 |"))
     tolerances, steps, errors = ([c.strip() for c in line.strip("|").split("|")[1:]]
                                  for line in (lines[top], lines[top + 2], lines[top + 3]))
@@ -289,11 +289,11 @@ def test_a_jacobi_master_with_coupling_left_at_1(slave):
     assert len(warnings) == 1 and "coupling = 2" in warnings[0]
 
 
-# ---------------------------- 26: a communication step of 1000 s (README)
+# ---------------------------- 26: a communication step of 1000 s (docs/numerics.md)
 
 @pytest.mark.parametrize("v", [V0, -1.0])
 def test_a_communication_step_of_1000_s(slave, v):
-    """README ("Sub-stepping"): free flight is one exact step, so a step of
+    """docs/numerics.md ("Sub-stepping"): free flight is one exact step, so a step of
     1000 s costs about a millisecond: the h20 impact's 13 161 contact steps
     and one flight step (the library's impact, to the bit), or with v = -1
     one flight step. It was refused (more than 1e9 steps of dt_max)."""

@@ -1,7 +1,8 @@
-"""README.md against the built FMUs: its fmpy commands write what it says,
-its co-simulation example has the right signs, its variable table covers
-modelDescription.xml. The README is what users copy from; these tests run
-the text itself, not a copy of it."""
+"""README.md and the guides of docs/ (tests/doc_pages.py) against the built
+FMUs: their fmpy commands write what they say, the co-simulation example
+has the right signs, the variables page covers modelDescription.xml. These
+pages are what users copy from; these tests run the text itself, not a copy
+of it, on whichever page it now lives."""
 
 import functools
 import math
@@ -18,52 +19,31 @@ import pytest
 from fmpy import simulate_fmu
 
 import fraccontact
+from doc_pages import all_blocks, fenced_blocks, inline_code, section, text
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-README = (ROOT / "README.md").read_text()
+README = text("README.md")
 CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
 M, V0 = 0.7437, 0.626418
 F_PEAK_H20 = 1045.2  # README, "Two commands": F_peak of the h20 drop test, law 1
 
 
-def fenced_blocks(text):
-    """(section heading, language, body) of every fenced code block."""
-    blocks, heading, lines, inside = [], "", [], None
-    for line in text.splitlines():
-        if inside is None and line.startswith("## "):
-            heading = line[3:].strip()
-        elif line.startswith("```"):
-            if inside is None:
-                inside, lines = line[3:].strip(), []
-            else:
-                blocks.append((heading, inside, "\n".join(lines) + "\n"))
-                inside = None
-        elif inside is not None:
-            lines.append(line)
-    return blocks
-
-
-def inline_code(text):
-    """The `code spans` outside fenced blocks (where prose quotes a command)."""
-    prose = re.sub(r"^```.*?^```", "", text, flags=re.S | re.M)
-    return re.findall(r"`([^`\n]+)`", prose)
-
-
-def fmpy_commands(text):
-    """Every `fmpy simulate` command the README shows, in a block or quoted
+def fmpy_commands():
+    """Every `fmpy simulate` command the pages show, in a block or quoted
     in prose with an FMU (prose may name the command itself alone)."""
     commands = []
-    for _, _, body in fenced_blocks(text):
+    for _, _, _, body in all_blocks():
         for line in body.replace("\\\n", " ").splitlines():
             if "fmpy simulate" in line:
                 commands.append(line.strip())
-    commands += [span for span in inline_code(text) if "fmpy simulate" in span and ".fmu" in span]
+    from doc_pages import PAGES
+    commands += [span for page in PAGES for span in inline_code(text(page)) if "fmpy simulate" in span and ".fmu" in span]
     return commands
 
 
 # --- issue 10, item 13: fmpy simulate must write something ------------------
 
-COMMANDS = fmpy_commands(README)
+COMMANDS = fmpy_commands()
 
 
 def test_the_readme_shows_how_to_simulate_with_fmpy():
@@ -102,8 +82,8 @@ def test_fmpy_simulate_command_writes_the_outputs(command, tmp_path):
 # --- issue 10, item 14: the master loop and its signs -----------------------
 
 def master_loop_block():
-    """The Python block of 'Use it in a co-simulation'."""
-    blocks = [body for heading, lang, body in fenced_blocks(README)
+    """The Python block of 'Use it in a co-simulation' (docs/coupling.md)."""
+    blocks = [body for _, heading, lang, body in all_blocks()
               if heading == "Use it in a co-simulation" and lang == "python"]
     assert len(blocks) == 1, "expected one Python master loop in 'Use it in a co-simulation'"
     return blocks[0]
@@ -118,11 +98,11 @@ def monolithic(g, t_end=3e-3):
 
 @functools.lru_cache(maxsize=None)
 def readme_master():
-    """Runs the README block as written (its own call and print included)
+    """Runs the page's block as written (its own call and print included)
     and hands back its namespace, so its function can be called again."""
     code = master_loop_block().replace('"build/fraccontact.fmu"', repr(str(CONTACT)))
     namespace = {"__name__": "readme_master"}
-    exec(compile(code, "README.md (master loop)", "exec"), namespace)
+    exec(compile(code, "docs/coupling.md (master loop)", "exec"), namespace)
     return namespace
 
 
@@ -134,7 +114,7 @@ def test_the_readme_master_loop_is_the_drop_test(g):
     is the master's striker (same m, g, start velocity) and F_avg its
     impulse, so the two runs differ by rounding only: about 1e-16 per
     step over 300 steps, ~3e-14 (2e-14 measured). 1e-12 leaves a factor
-    30 and is still 100 times inside the README's promise of 1e-10.
+    30 and is still 100 times inside docs/coupling.md's promise of 1e-10.
     A wrong sign is no small error: the striker never rebounds (eps < 0)."""
     T = 3e-3
     v_end, impulse = readme_master()["drop"](str(CONTACT), g=g)
@@ -148,14 +128,14 @@ def test_the_readme_master_loop_is_the_drop_test(g):
 
 
 # --- issue 10, item 7: the variable table -----------------------------------
+# (its value references, causalities, units and defaults: test_parameter_table.py)
 
 def variable_table():
-    """name -> row cells of the table in 'The FMU's variables'."""
-    section = README.split("## The FMU's variables", 1)[1].split("\n## ", 1)[0]
+    """name -> row cells of the table in docs/variables.md's 'What each variable does'."""
     rows = {}
-    for line in section.splitlines():
+    for line in section("What each variable does").splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("|") and len(cells) > 2 and not set(cells[0]) <= {"-"}:
+        if line.startswith("|") and len(cells) >= 2 and not set(cells[0]) <= {"-"}:
             for name in re.findall(r"`([^`]+)`", cells[0]):
                 rows[name] = cells
     return rows
@@ -169,26 +149,7 @@ def model_variables():
 def test_every_variable_is_in_the_readme_table():
     table = variable_table()
     missing = [v.get("name") for v in model_variables() if v.get("name") not in table]
-    assert not missing, f"not in README's variable table: {missing}"
-
-
-def test_the_table_agrees_with_model_description():
-    """Value reference, causality, unit and default as the FMU declares them."""
-    table = variable_table()
-    for var in model_variables():
-        name, kind = var.get("name"), var[0]
-        _, vrs, causality, unit, default = table[name][:5]
-        names = re.findall(r"`([^`]+)`", table[name][0])
-        i = names.index(name)  # rows such as `E_i`, `nu_i` list values in that order
-        assert vrs.split(",")[i].strip() == var.get("valueReference"), name
-        assert causality.split()[0] == var.get("causality"), name
-        if kind.tag != "Real":
-            assert kind.tag in causality, name
-        if kind.get("unit"):
-            declared = kind.get("unit").replace("N.s", "N·s").replace("m1.5", "m^1.5").replace("s2", "s²")
-            assert unit.split(",")[i].strip() == declared, name
-        if kind.get("start"):
-            assert float(default.split(",")[i]) == float(kind.get("start")), name
+    assert not missing, f"not in docs/variables.md's table of what each variable does: {missing}"
 
 
 MATERIALS = ("R", "E_i", "nu_i", "E_s", "nu_s")
@@ -228,10 +189,10 @@ def test_the_readme_fmi3_example_returns_where_it_says():
     """The Python block of 'FMI 2.0 or FMI 3.0', run as written: its comment
     names the onset and separation times (7 digits), and each appears twice."""
     fmu3 = CONTACT.parent / "fraccontact-fmi3.fmu"
-    [block] = [body for heading, lang, body in fenced_blocks(README)
+    [block] = [body for _, heading, lang, body in all_blocks()
                if heading == "FMI 2.0 or FMI 3.0" and lang == "python"]
     namespace = {}
-    exec(compile(block.replace('"build/fraccontact-fmi3.fmu"', repr(str(fmu3))), "README.md (FMI 3.0)", "exec"),
+    exec(compile(block.replace('"build/fraccontact-fmi3.fmu"', repr(str(fmu3))), "docs/fmi3.md (FMI 3.0)", "exec"),
          namespace)
     t = namespace["r"]["time"]
     off_grid = t[np.abs(t / 1e-5 - np.round(t / 1e-5)) > 1e-6]
@@ -246,12 +207,12 @@ def test_the_readme_fmi3_example_returns_where_it_says():
 BUILT = {"build/fraccontact.fmu": CONTACT, "build/fraccontact-fmi3.fmu": CONTACT.parent / "fraccontact-fmi3.fmu",
          "build/striker.fmu": pathlib.Path(os.environ.get("STRIKER_FMU", CONTACT.parent / "striker.fmu")),
          "build/drop_test.ssp": pathlib.Path(os.environ.get("DROP_TEST_SSP", CONTACT.parent / "drop_test.ssp"))}
-PYTHON_BLOCKS = [(heading, body) for heading, lang, body in fenced_blocks(README) if lang == "python"]
+PYTHON_BLOCKS = [(f"{page} {heading}", body) for page, heading, lang, body in all_blocks() if lang == "python"]
 
 
 @functools.lru_cache(maxsize=None)
 def run_block(body):
-    """A README block in a fresh interpreter (a user's first try: no state left
+    """A page's block in a fresh interpreter (a user's first try: no state left
     by other tests, such as a log level), on this build's files: its stdout and
     stderr together, as a terminal shows them."""
     for name, built in BUILT.items():
@@ -273,7 +234,7 @@ def test_every_python_block_runs_quietly(heading, body):
 def test_the_readme_ssp_examples_print_what_they_say(master):
     """The Python blocks of 'The scene as SSP', run as written on this
     build's drop_test.ssp: each prints the F_peak its comment names."""
-    blocks = [body for heading, body in PYTHON_BLOCKS if heading.startswith("The scene as SSP")]
+    blocks = [body for _, heading, lang, body in all_blocks() if heading.startswith("The scene as SSP") and lang == "python"]
     [block] = [b for b in blocks if ("libcosimpy" in b) == (master == "libcosim")]
     printed = [float(x) for x in re.findall(r"[-\d.e+]+", run_block(block))]
     said = float(re.search(r"# (\d+\.\d+) N", block).group(1))

@@ -15,7 +15,7 @@ from fraccontact import crash, hertz
 from fraccontact.scenes import bumper, headform, parameters
 from fraccontact.scenes.chain import GROUND, Chain, Contact, Link
 
-K, C = 329.9e6, 6080.0          # the paper's h20 polypropylene (MODEL.md §6)
+K, C = 329.9e6, 6080.0          # the paper's h20 polypropylene (docs/model.md §1)
 
 
 def two_free_bodies(m1, m2, v):
@@ -39,7 +39,7 @@ def test_two_free_bodies_are_the_single_body_impact_of_the_reduced_mass(m1, m2, 
     for name, value in two.items():
         # scipy at rtol 1e-12 and the library's error control at its finest
         # tolerance, 1e-12, whose figures come within about 15 tolerances
-        # (README, "Error-controlled steps"); the peak is taken from 200001
+        # (docs/numerics.md, "Error-controlled steps"); the peak is taken from 200001
         # samples of the contact (1e-11).
         assert value == pytest.approx(getattr(one, name), rel=1e-9, abs=0), name
     # Equal and opposite forces: the momentum is the integrator's linear

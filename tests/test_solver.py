@@ -60,14 +60,14 @@ def test_json_has_the_promised_keys():
 
 @pytest.mark.parametrize("args, method", [
     ([], "sdirk2"), (["--scheme", "central"], "central"), (["--reference"], "reference"),
-    (["--damper", "2", "--memory", "1"], "bdf2-g1"),
-    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3"], "esdirk5"),
-    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3", "--damper", "2", "--memory", "2"], "esdirk5"),
+    (["--damper", "2", "--memory", "1"], "g1_history"),
+    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3"], "esdirk54"),
+    (["--law", "2", "--tolerance", "1e-6", "--dt-max", "1e-3", "--damper", "2", "--memory", "2"], "esdirk54"),
     (["--law", "1", "--tolerance", "1e-6"], "sdirk2")])  # G1 with N = steps: fixed steps (and a warning)
 def test_json_names_the_method_that_ran(args, method):
     r = solve_json("--t-end", "2e-3", *args)
     assert r["method"] == method
-    if method == "esdirk5":  # its own steps, not dt_max's: the 1.3 ms contact in far fewer than 1e-3/1e-7
+    if method == "esdirk54":  # its own steps, not dt_max's: the 1.3 ms contact in far fewer than 1e-3/1e-7
         assert r["steps"] < 1000
 
 
@@ -194,7 +194,7 @@ def test_no_figure_depends_on_the_output_interval(method, tmp_path):
 def test_per_impact_figures_against_the_reference():
     """Each impact's figures from the model (Hertz law, dt 1e-7) against the
     GSL reference, impact by impact. The scheme's error at this step is about
-    1e-9 relative for h20 (README: 8.7e-10 in F_peak, 3.3e-9 in eps); free
+    1e-9 relative for h20 (docs/benchmarks.md: 8.7e-10 in F_peak, 3.3e-9 in eps); free
     flight is exact, so later impacts inherit only that: 1e-7 leaves two
     orders of margin and fails any mix-up between impacts (they differ by
     tens of percent)."""
@@ -493,7 +493,7 @@ def test_the_reference_warns_that_the_models_steps_change_nothing(option, value)
 def test_the_reference_says_which_law_it_solves():
     """Without --law the reference solves the G1 law's continuous limit, the
     Hertz law, and says so; the same figures as --law hertz to the bit. With
-    a fixed N it solves the G1 law on N intervals (MODEL.md §4): the
+    a fixed N it solves the G1 law on N intervals (docs/model.md §4): the
     model's figures at a fine step, not the Hertz law's."""
     assert solve("--reference").stdout.startswith("reference, law hertz,")
     hertz = without_timing(solve_json("--reference", "--law", "hertz"))

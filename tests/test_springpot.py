@@ -1,4 +1,4 @@
-"""The springpot damper F = c_alpha D^alpha x2 (issue 12, MODEL.md §7-§8) and
+"""The springpot damper F = c_alpha D^alpha x2 (issue 12, docs/model.md §5-§6) and
 the general spring exponent n, against what is known independently of the C
 code: closed forms (the power rule, the fractional Maxwell model's
 Mittag-Leffler function computed here with mpmath, the elastic contact time
@@ -54,8 +54,8 @@ def reference(*args):
     return json.loads(done.stdout)
 
 
-# Alexander's SDIRK2 and the Taylor coefficients of R(z) - e^z (MODEL.md's
-# scheme; contact.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
+# Alexander's SDIRK2 and the Taylor coefficients of R(z) - e^z (docs/model.md
+# §11; sdirk2.c's SDIRK_GAMMA): R(z) = (1 + (1-2g) z) sum_k (k+1) g^k z^k.
 SDIRK = 1.0 - 1.0 / math.sqrt(2.0)
 C3 = 3 * SDIRK ** 2 - 2 * SDIRK ** 3 - 1.0 / 6.0     # 0.0404401...
 C4 = 4 * SDIRK ** 3 - 3 * SDIRK ** 4 - 1.0 / 24.0    # 0.0367550...
@@ -86,7 +86,7 @@ def mittag_leffler_series(alpha, z):
 
 def maxwell_g(alpha, lam, t):
     """t E_{alpha,2}(-lam t^alpha): the inverse Laplace transform of
-    s^(alpha-2)/(s^alpha + lam) (MODEL.md §7), by Talbot's contour in
+    s^(alpha-2)/(s^alpha + lam) (docs/model.md §5), by Talbot's contour in
     mpmath at 30 digits. F(t) = k v maxwell_g(t) for the linear spring n = 1
     in series with the springpot driven at v from t = 0."""
     if t <= 0.0:
@@ -126,7 +126,7 @@ def sdirk2_rigid_ratio(alpha, n):
 def shifted_g1_rigid_ratio(alpha, j):
     """F_j / (c v h^(1-alpha)/Gamma(2-alpha)) of memory = 1 for x2 = v t on
     its grid: G_j = sum_{i<j} w_i x2_(j-i) = v h Gamma(j+1-alpha)/(Gamma(2-alpha) Gamma(j))
-    (MODEL.md §4's straight-line sum with order alpha), F_j = c h^-alpha
+    (docs/model.md §4's straight-line sum with order alpha), F_j = c h^-alpha
     ((1 + alpha/2) G_j - (alpha/2) G_(j-1)), and the first step (backward
     Euler, no shift) F_1 = c h^-alpha G_1 = c v h^(1-alpha)."""
     if j == 1:
@@ -187,7 +187,7 @@ def rigid_rows(alpha, memory, h, n_end, every, **extra):
 
 
 def power_rule(alpha, t):
-    """MODEL.md §7: F = c_alpha v t^(1-alpha)/Gamma(2-alpha) for x2 = v t."""
+    """docs/model.md §5: F = c_alpha v t^(1-alpha)/Gamma(2-alpha) for x2 = v t."""
     return C_ALPHA * V * t ** (1 - alpha) / math.gamma(2 - alpha)
 
 
@@ -291,7 +291,7 @@ def maxwell_error(alpha, memory, steps):
 @pytest.mark.parametrize("memory", [1, 2])
 @pytest.mark.parametrize("alpha", [0.2, 0.5, 0.8, 1.0])
 def test_linear_spring_meets_the_mittag_leffler_force_at_the_measured_order(alpha, memory):
-    """F(t) = k v t E_{alpha,2}(-(k/c_alpha) t^alpha) (MODEL.md §7): an
+    """F(t) = k v t E_{alpha,2}(-(k/c_alpha) t^alpha) (docs/model.md §5): an
     error that falls at the scheme's order proves the limit (a wrong closed
     form would leave a floor, and an order near 0); the band's lower edge p
     bounds the error at T/800 by Richardson's (e(T/400) - e(T/800))/(2^p - 1).
@@ -483,7 +483,7 @@ def spring_k(n):
 
 def equivalent_c_alpha(alpha, c=6080.0, omega=2400.0):
     """A springpot as damping as the h20 dashpot at the impact's frequency
-    pi/t_c (the default c_alpha's rule, contact.c): c_alpha omega^alpha = c omega."""
+    pi/t_c (the default c_alpha's rule, parameters.c): c_alpha omega^alpha = c omega."""
     return c * omega ** (1 - alpha)
 
 
@@ -508,7 +508,7 @@ def identity_defects(slave, n, memory, dt_max, H=1e-5, t_end=2.5e-3):
 @pytest.mark.parametrize("n", [1.0, 1.5, 2.0])
 def test_energy_and_impulse_identities_of_a_springpot_drop(slave, n, memory):
     """1/2 m v0^2 = 1/2 m v^2 + k x1^(n+1)/(n+1) + int F dx2 and m (v0 - v)
-    = int F dt (MODEL.md §7, no gravity). Neither scheme conserves energy
+    = int F dt (docs/model.md §9, no gravity). Neither scheme conserves energy
     exactly: the defect is its error, second order, so the largest over the
     run falls 4x from dt_max = 1e-6 to 5e-7 (order 2 +- 0.2; measured 1.99-
     2.03, defects 1.2e-7 to 2.6e-7 at 1e-6 for memory 2 and 4.3e-6 to 6.0e-6
@@ -755,7 +755,7 @@ def test_the_number_of_modes_grows_like_the_log_of_the_span():
         assert abs(more - fewer - math.log(10) / du) <= 1.0, counts
 
 
-# MODEL.md §8: the published number of exponentials for tau^(-1/2) on
+# docs/model.md §6: the published number of exponentials for tau^(-1/2) on
 # [delta, T] (Jiang, Zhang, Zhang & Zhang 2017), by relative accuracy and
 # delta/T; ours spans [dt_max, 1000 s], so dt_max = 1000 delta/T. Measured
 # (alpha 0.5, ours counting the lumped spring; the lumped dashpot eta has no
@@ -1027,7 +1027,7 @@ def test_spring_exponent_against_the_gsl_reference(n):
 
 @pytest.mark.parametrize("n", [1.0, 2.0, 2.5])
 def test_g1_law_for_a_general_exponent_has_the_straight_line_ratio(slave, n):
-    """MODEL.md §7: x1^n = Gamma(n+1) D^-(n-1) x1, and G1 on N intervals
+    """docs/model.md §3: x1^n = Gamma(n+1) D^-(n-1) x1, and G1 on N intervals
     gives k x1^n Gamma(N+n)/(Gamma(N) N^n) (the straight line's sum, §4).
     Driven at v with a rigid dashpot (c = 1e20: x1 = v t to 1e-17), N =
     internal steps since onset (10 per communication step): the ratio is

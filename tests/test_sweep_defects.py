@@ -121,8 +121,8 @@ def test_the_disk_bound_is_where_the_help_says(csv, no_cluster, tmp_path, capsys
 
 
 def readme_sweep_section():
-    readme = open(os.path.join(os.path.dirname(__file__), "..", "README.md")).read()
-    return " ".join(readme[readme.index("For campaigns, `fraccontact sweep`"):readme.index("## The solver")].split())
+    page = open(os.path.join(os.path.dirname(__file__), "..", "docs", "sweeps.md")).read()
+    return " ".join(page[page.index("For campaigns, `fraccontact sweep`"):].split())
 
 
 def help_text(capsys):
@@ -282,5 +282,5 @@ def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys, monkeypat
 
 
 def test_the_drift_the_readme_shows():
-    """The README's example of what adding doubles gives, beside the grid's 0.035 (test_grid_rule)."""
+    """docs/sweeps.md's example of what adding doubles gives, beside the grid's 0.035 (test_grid_rule)."""
     assert repr(0.005 + 6 * 0.005) == "0.034999999999999996" and "0.034999999999999996" in readme_sweep_section()

@@ -369,16 +369,16 @@ def test_a_worker_killed_mid_run_loses_nothing(cluster, tmp_path):
     assert [(tmp_path / "reference" / name).read_bytes() for name in names] == data
 
 
-# ---------------------------------------------------------------- the README's figures
+# ---------------------------------------------------------------- the figures of docs/sweeps.md
 
 
 def test_the_readme_quotes_the_scaling_report():
-    """Each figure the README gives of the sweep at scale is the one
+    """Each figure docs/sweeps.md gives of the sweep at scale is the one
     docs/sweep_scaling.md measured (scripts/report sweep_scaling)."""
     import re
     root = os.path.join(os.path.dirname(__file__), "..")
     doc = open(os.path.join(root, "docs", "sweep_scaling.md")).read()
-    readme = " ".join(open(os.path.join(root, "README.md")).read().split())
+    readme = " ".join(open(os.path.join(root, "docs", "sweeps.md")).read().split())
 
     def cell(row, column):
         line = next(line for line in doc.splitlines() if line.startswith(f"| {row}"))

@@ -83,7 +83,7 @@ def test_steps_stay_under_dt_max(reference):
 @pytest.mark.parametrize("law", ["g1", "g1x"])
 def test_g1_laws_with_fixed_nodes_are_the_hertz_law_with_their_stiffness(law):
     """With g1_nodes = N the G1 laws are a Hertz spring of stiffness k times
-    MODEL.md §4's ratio (tests/closed_forms.py computes it independently), so
+    docs/model.md §4's ratio (tests/closed_forms.py computes it independently), so
     their error-controlled impact is the Hertz law's at that k, step for step."""
     from closed_forms import extrapolated_ratio, g1_line_ratio
     N = 50

@@ -1,7 +1,7 @@
-"""Writes the README's example drop-test data (docs/examples/*.csv): measured-
+"""Writes docs/fitting.md's example drop-test data (docs/examples/*.csv): measured-
 looking force curves and a drop campaign made by the contact FMU (through fmpy)
 from stated constants, with Gaussian noise of stated seeds, so that the
-README's `fraccontact fit` commands run as written and what they find can be
+`fraccontact fit` commands of docs/fitting.md run as written and what they find can be
 checked against the constants that made the data.
 
     .venv/bin/python docs/examples/make_examples.py [FMU [FOLDER]]   # build/fraccontact.fmu, docs/examples

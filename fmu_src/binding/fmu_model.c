@@ -3,6 +3,7 @@
 #include "fmu_vars.h"
 #include "serial.h"
 
+#include <float.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stddef.h>
@@ -23,10 +24,17 @@ typedef struct {
     contact_model model;  /* the state at its end */
 } prediction;
 
+/* The inputs: the striker's velocity and mass, the second body's, and the
+ * accelerations the forces other than this contact give each of them
+ * (docs/two_bodies.md). The model's striker is their relative motion. */
+typedef struct {
+    double v, m, v2, m2, a, a2;
+} bodies;
+
 struct fmu_model {
     contact_params params;
     int coupling;         /* enum fmu_coupling */
-    double v, m;          /* the inputs as last set */
+    bodies in;            /* the inputs as last set */
     double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
     double F_avg;         /* impulse of the last communication step / its length */
     double step_span;     /* that length: where an early return cut it, so far */
@@ -55,8 +63,12 @@ struct fmu_model {
 #define MAX_STEPS 1000000000
 
 static const fmu_variable variable_list[] = {
-    {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v)},
-    {VR_m, "m", VAR_REAL, VAR_INPUT, offsetof(fmu_model, m)},
+    {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.v)},
+    {VR_m, "m", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.m)},
+    {VR_v2, "v2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.v2)},
+    {VR_m2, "m2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.m2)},
+    {VR_a, "a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.a)},
+    {VR_a2, "a2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.a2)},
     {VR_R, "R", VAR_REAL, VAR_PARAMETER, PARAM(R)},
     {VR_E_i, "E_i", VAR_REAL, VAR_PARAMETER, PARAM(E_i)},
     {VR_nu_i, "nu_i", VAR_REAL, VAR_PARAMETER, PARAM(nu_i)},
@@ -106,6 +118,56 @@ static int check_coupling(int coupling, char *why, size_t len)
                           "2 = F_avg_next before it (Jacobi)");
 }
 
+/* The approach speed of the two bodies: the model's striker velocity. */
+static double approach(const bodies *b)
+{
+    return b->v - b->v2;
+}
+
+/* The mass of the model's striker: the reduced mass m m2/(m + m2) of two
+ * free bodies, m where the second is held (m2 = 0), 0 where the rate is
+ * prescribed (m = 0). */
+static double proxy_mass(const bodies *b)
+{
+    return b->m > 0.0 && b->m2 > 0.0 ? 1.0 / (1.0 / b->m + 1.0 / b->m2) : b->m;
+}
+
+/* What the other forces add to the approach's acceleration. */
+static double other_accel(const bodies *b)
+{
+    return b->a - b->a2;
+}
+
+/* 0 when the inputs are usable in `scene` with the parameters *p (which
+ * passed their check), else -1 and why: the striker's own rules, and the
+ * same for the model's striker, the relative motion (the approach speed
+ * and the reduced mass). */
+static int check_bodies(const contact_params *p, int scene, const bodies *b, char *why, size_t len)
+{
+    const double mass = proxy_mass(b), accel = p->g + other_accel(b);
+    if (contact_check_striker(p, scene, b->v, b->m, why, len) != 0)
+        return -1;
+    if (!isfinite(b->v2))
+        return contact_reject(why, len, "v2", b->v2, "the second body's velocity must be finite [m/s]");
+    if (!(b->m2 == 0.0 || (b->m2 >= DBL_MIN && b->m2 <= DBL_MAX)))
+        return contact_reject(why, len, "m2", b->m2,
+                              "the second body's mass must be positive, finite and not denormal, or 0 (held "
+                              "fixed) [kg]");
+    if (!isfinite(b->a))
+        return contact_reject(why, len, "a", b->a,
+                              "the striker's acceleration from its other forces must be finite [m/s^2]");
+    if (!isfinite(b->a2))
+        return contact_reject(why, len, "a2", b->a2,
+                              "the second body's acceleration from its other forces must be finite [m/s^2]");
+    if (isfinite(b->v) && !isfinite(approach(b)))
+        return contact_reject(why, len, "v2", b->v2, "the approach speed v - v2 must be finite [m/s]");
+    if (!isfinite(accel) || (p->damper == CONTACT_DAMPER_DASHPOT && !isfinite(mass * accel * (mass * accel) / p->c)))
+        return contact_reject(why, len, "a", b->a,
+                              "the approach's acceleration g + a - a2 must be finite, and so must the power "
+                              "(m_r (g + a - a2))^2 / c it can dissipate (m_r the reduced mass m m2/(m + m2))");
+    return b->v2 == 0.0 && b->m2 == 0.0 ? 0 : contact_check_striker(p, scene, approach(b), mass, why, len);
+}
+
 /* Applies a parameter change only if the parameters stay valid. */
 static fm_status set_parameter(fmu_model *fm, const fmu_variable *var, const void *value, size_t size)
 {
@@ -130,10 +192,10 @@ static void preview_start(fmu_model *fm)
     if (fm->started)
         return;
     if (contact_check_params(&fm->params, why, sizeof why) == 0
-        && contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, fm->v, fm->m, why, sizeof why) == 0) {
+        && check_bodies(&fm->params, CONTACT_SCENE_DRIVEN, &fm->in, why, sizeof why) == 0) {
         /* The mass only scales the dynamics, which a preview does not run. */
         contact_release(&fm->model);
-        contact_start(&fm->model, &fm->params, fm->v, fm->m > 0.0 ? fm->m : 1.0);
+        contact_start(&fm->model, &fm->params, approach(&fm->in), fm->in.m > 0.0 ? proxy_mass(&fm->in) : 1.0);
     }
 }
 
@@ -166,7 +228,7 @@ void fm_reset(fmu_model *fm)
     memset(fm, 0, sizeof *fm);
     fm->log = log;
     contact_default_params(&fm->params);
-    contact_default_striker(&fm->v, &fm->m);
+    contact_default_striker(&fm->in.v, &fm->in.m);
     fm->coupling = COUPLING_GAUSS_SEIDEL;
     preview_start(fm);
 }
@@ -174,6 +236,7 @@ void fm_reset(fmu_model *fm)
 fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
 {
     const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
+    bodies trial;
     char why[256];
     if (!var)
         return FM_ERROR;
@@ -182,12 +245,13 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
     /* Inputs: the rules that depend on the scene (m > 0 in the drop test)
      * or on other parameters (a uniform grid's resolution) wait for
      * fm_start, since those may still change. */
-    if (contact_check_striker(&fm->params, CONTACT_SCENE_DRIVEN, vr == VR_v ? value : fm->v,
-                              vr == VR_m ? value : fm->m, why, sizeof why) != 0
-        || (fm->started && contact_check_resolution(&fm->params, vr == VR_v ? value : fm->v,
-                                                    vr == VR_m ? value : fm->m, why, sizeof why) != 0))
+    trial = fm->in;
+    *(double *)((char *)&trial + (var->offset - offsetof(fmu_model, in))) = value;
+    if (check_bodies(&fm->params, CONTACT_SCENE_DRIVEN, &trial, why, sizeof why) != 0
+        || (fm->started
+            && contact_check_resolution(&fm->params, approach(&trial), proxy_mass(&trial), why, sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
-    *(double *)((char *)fm + var->offset) = value;
+    fm->in = trial;
     if (vr == VR_v)
         fm->v_slope = 0.0; /* a new value: the old slope no longer describes it */
     return FM_OK;
@@ -319,14 +383,14 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
     char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
-        || contact_check_striker(&fm->params, fm->params.scene, fm->v, fm->m, why, sizeof why) != 0
-        || contact_check_resolution(&fm->params, fm->v, fm->m, why, sizeof why) != 0
+        || check_bodies(&fm->params, fm->params.scene, &fm->in, why, sizeof why) != 0
+        || contact_check_resolution(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why) != 0
         || (isfinite(t_stop)
-            && contact_check_history_span(&fm->params, fm->v, fm->m, t_stop - t0, 0, "stopTime - startTime", why,
-                                          sizeof why) != 0))
+            && contact_check_history_span(&fm->params, approach(&fm->in), proxy_mass(&fm->in), t_stop - t0, 0,
+                                          "stopTime - startTime", why, sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_release(&fm->model);
-    contact_start(&fm->model, &fm->params, fm->v, fm->m);
+    contact_start(&fm->model, &fm->params, approach(&fm->in), proxy_mass(&fm->in));
     fm->model.max_steps = MAX_STEPS;
     fm->model.s.t = t0;
     fm->F_avg = 0.0;
@@ -340,8 +404,12 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why)
-        || contact_step_warning(&fm->params, fm->v, fm->m, why, sizeof why))
+        || contact_step_warning(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
+    if (other_accel(&fm->in) != 0.0 && fm->params.scene == CONTACT_SCENE_DROP)
+        return report(fm, FM_WARNING, "logStatusWarning",
+                      "a = %g and a2 = %g have no effect in the drop test (scene = 1): its striker's only other "
+                      "force is g", fm->in.a, fm->in.a2);
     if (fm->coupling != COUPLING_GAUSS_SEIDEL && fm->params.scene == CONTACT_SCENE_DROP)
         return report(fm, FM_WARNING, "logStatusWarning",
                       "coupling = %d has no effect in the drop test (scene = 1): the FMU's striker is its own",
@@ -434,10 +502,11 @@ static double start_velocity(const fmu_model *fm, double v_end, int *other)
 {
     double jacobi, gauss_seidel, v;
     *other = 0;
-    if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->m > 0.0))
-        return fm->v;
-    jacobi = fm->v - fm->owed / fm->m;
-    gauss_seidel = fm->v;
+    if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->in.m > 0.0))
+        return approach(&fm->in);
+    /* the impulse owed acts on both bodies: on their approach through the reduced mass */
+    jacobi = approach(&fm->in) - fm->owed / proxy_mass(&fm->in);
+    gauss_seidel = approach(&fm->in);
     v = fm->coupling == COUPLING_JACOBI ? jacobi : gauss_seidel;
     if (same_motion(fm, v, v_end))
         return v_end;
@@ -516,7 +585,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     t_start = cm->s.t;
     v_end = cm->s.v;
-    contact_drive(cm, start_velocity(fm, v_end, &other_coupling), fm->m, fm->v_slope);
+    contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
+                  fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
     before = cm->s;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
@@ -625,7 +695,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
-    I(params.scheme), F(params.spring_exponent), I(params.damper), F(v), F(m), F(v_slope), F(F_avg), F(step_span),
+    I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
+    F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
@@ -697,7 +768,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     if (problem)
         return report(fm, FM_ERROR, "logStatusError", "%s", problem);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
-        || contact_check_striker(&trial.params, CONTACT_SCENE_DRIVEN, trial.v, trial.m, why, sizeof why) != 0
+        || check_bodies(&trial.params, CONTACT_SCENE_DRIVEN, &trial.in, why, sizeof why) != 0
         || check_coupling(trial.coupling, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)

@@ -1,4 +1,4 @@
-/* The contact FMU's variables (DESIGN.md: the interface table) on top of the
+/* The contact FMU's variables (docs/variables.md) on top of the
  * contact model: value references, start values, who may set what and when,
  * and the mapping of a communication step onto the model. It implements
  * fmu_interface.h for the FMI glue. */
@@ -19,6 +19,7 @@ enum fmu_vr {
     VR_v_striker = 19, VR_E_diss = 20, VR_eps = 21, VR_semi_integral = 22,
     VR_spring_exponent = 23, VR_damper_order = 24, VR_c_alpha = 25, VR_memory_tolerance = 26,
     VR_tolerance = 27, VR_F_avg_next = 28,
+    VR_v2 = 36, VR_m2 = 37, VR_a = 38, VR_a2 = 39,
     VR_law = 30, VR_g1_nodes = 31, VR_scene = 32, VR_damper = 33, VR_memory = 34, VR_coupling = 35,
     VR_contact = 40
 };

@@ -1,4 +1,4 @@
-/* The rheological contact model of MODEL.md §2, §4 and §7: a striker pushing
+/* The rheological contact model of docs/model.md §2, §4 and §5: a striker pushing
  * on a spring k x1^n in series with a damper, a linear dashpot or a springpot
  * c_alpha D^alpha x2 whose memory is kept either as the literal G1 history or
  * as a sum of exponentials (soe.h). Knows nothing of FMI; the FMU and the
@@ -17,7 +17,7 @@ enum contact_law {
 
 enum contact_scheme {
     CONTACT_SCHEME_SDIRK2 = 1,  /* L-stable implicit, second order, events located (default) */
-    CONTACT_SCHEME_CENTRAL = 2  /* the paper's explicit central differences (MODEL.md §5) */
+    CONTACT_SCHEME_CENTRAL = 2  /* the paper's explicit central differences (docs/model.md §15) */
 };
 
 /* Events at which contact_advance_until can stop, as bits. */
@@ -37,18 +37,18 @@ typedef int (*contact_poll)(void *ctx);
 
 enum contact_damper {
     CONTACT_DAMPER_DASHPOT = 1,  /* F = c x2' */
-    CONTACT_DAMPER_SPRINGPOT = 2 /* F = c_alpha D^alpha x2 (Caputo from t = 0), MODEL.md §7 */
+    CONTACT_DAMPER_SPRINGPOT = 2 /* F = c_alpha D^alpha x2 (Caputo from t = 0), docs/model.md §5 */
 };
 
 enum contact_memory {
     CONTACT_MEMORY_G1 = 1,        /* the springpot's literal G1 history sum: uniform steps, O(N) each */
-    CONTACT_MEMORY_COMPRESSED = 2 /* a sum of exponentials: M modes, any step (MODEL.md §8) */
+    CONTACT_MEMORY_COMPRESSED = 2 /* a sum of exponentials: M modes, any step (docs/model.md §6) */
 };
 
 /* The compressed memory's largest number of modes, and the span over which
  * its kernel holds the tolerance: from dt_max to CONTACT_MEMORY_SPAN, or
  * with error-controlled steps (which go far below dt_max) from the smaller
- * of dt_max and CONTACT_MEMORY_FLOOR (contact.c says why that floor). */
+ * of dt_max and CONTACT_MEMORY_FLOOR (parameters.c says why that floor). */
 #define CONTACT_MAX_MODES 160
 #define CONTACT_MEMORY_SPAN 1e3
 #define CONTACT_MEMORY_FLOOR 1e-9
@@ -57,7 +57,7 @@ enum contact_memory {
 #define CONTACT_DEFAULT_STEP 1e-7
 
 /* A fixed step resolves an impact when at least this many of them fit in
- * the time the spring takes to stop the striker (contact.c,
+ * the time the spring takes to stop the striker (resolution.c,
  * turnaround_time); a contact that dt_max does not resolve is stepped at
  * CONTACT_REFINED steps in that time instead: about the resolution the
  * default step gives the paper's h20 impact. */
@@ -67,6 +67,15 @@ enum contact_memory {
 /* The full G1 history keeps x2 at every step of the run: at most this many
  * steps (8 MiB of history, and as much for the G1 weights). */
 #define CONTACT_G1_HISTORY_MAX 1048576
+
+/* The method a configuration runs, each in a file named for it: decided by
+ * contact_method alone, and named by contact_method_name. */
+enum contact_method {
+    CONTACT_METHOD_SDIRK2 = 1,     /* fixed steps: SDIRK2 (sdirk2.c) */
+    CONTACT_METHOD_ESDIRK54 = 2,   /* error-controlled steps, tolerance > 0: ESDIRK 5(4) (esdirk54.c) */
+    CONTACT_METHOD_G1_HISTORY = 3, /* the springpot's full G1 history, BDF2 on a uniform grid (g1_history.c) */
+    CONTACT_METHOD_CENTRAL = 4     /* the paper's central differences on a uniform grid (central.c) */
+};
 
 enum contact_scene {
     CONTACT_SCENE_DROP = 1,   /* the model owns a free striker */
@@ -189,7 +198,7 @@ typedef struct {
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
 
-/* The paper's h20 test (MODEL.md §6, DESIGN.md): the parameters, and the
+/* The paper's h20 test (docs/model.md §1): the parameters, and the
  * striker's impact velocity v [m/s] and mass m [kg]. */
 void contact_default_params(contact_params *p);
 void contact_default_striker(double *v, double *m);
@@ -214,6 +223,11 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
  * scheme, the springpot's full G1 history). Returns 1 and the
  * message naming such parameters, or 0. */
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
+
+/* The method these parameters run (docs/model.md §16), and its name:
+ * "sdirk2", "esdirk54", "g1_history" or "central". */
+enum contact_method contact_method(const contact_params *p);
+const char *contact_method_name(enum contact_method method);
 
 /* 1 when the model chooses its steps by p->tolerance (tolerance > 0 where
  * it applies), 0 when it takes fixed steps of dt_max. */
@@ -298,10 +312,12 @@ int contact_check_history_span(const contact_params *p, double v, double m, doub
 int contact_steps_uniformly(const contact_model *cm);
 
 /* Driven scene: the indentation rate v from now on; m > 0 lets the model move
- * the striker with that inertia until the next call (a proxy striker), m = 0
- * prescribes the rate: v + slope (t - now) (slope 0: v held). The drop test
- * ignores the call: its striker is the model's own. */
-void contact_drive(contact_model *cm, double v, double m, double slope);
+ * the striker with that inertia until the next call (a proxy striker), under
+ * g + accel besides the contact force (accel: what the caller's other forces
+ * give the striker, relative to the specimen), m = 0 prescribes the rate:
+ * v + accel (t - now) (accel 0: v held). The drop test ignores the call: its
+ * striker is the model's own. */
+void contact_drive(contact_model *cm, double v, double m, double accel);
 
 /* The state's rates now: x1' (0 out of contact), v', and the spring force's
  * F' = n K x1^(n-1) x1' at the current stiffness. */
@@ -311,14 +327,17 @@ void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, dou
  * memory (negative while the dent recovers). */
 double contact_damper_rate(const contact_model *cm);
 
-/* Advances the model by H >= 0 in equal internal steps of at most dt_max that
- * land exactly on t + H (in contact, fixed steps are shorter where dt_max
- * would not resolve the impact: CONTACT_REFINED), locating contact onset
- * and separation within a step;
- * free flight is one exact step (while a springpot recovers, steps growing
- * with the time since separation). The full G1 history takes steps of
- * dt_max, and onset and separation fall on them (contact_check_advance
- * first). Returns the impulse of the contact force
+/* Advances the model by H >= 0 to exactly t + H by the method of
+ * contact_method. Out of contact free flight is one exact step (while a
+ * springpot recovers, steps growing with the time since separation). In
+ * contact SDIRK2 takes equal steps of at most contact_step_limit (shorter
+ * where that would not resolve the impact: CONTACT_REFINED), ESDIRK 5(4)
+ * the steps its controller chooses for the tolerance, at most
+ * contact_step_limit; both locate contact onset and separation within a
+ * step. The uniform grids step throughout: central differences in equal
+ * steps of at most dt_max, the full G1 history in steps of dt_max
+ * (contact_check_advance first); onset and separation fall on their steps.
+ * Returns the impulse of the contact force
  * over the interval [N s]; on a numerical failure (a non-finite state)
  * returns NaN and leaves the state as it was at the start of the advance;
  * the same when it would take more than cm->max_steps internal steps
@@ -350,7 +369,7 @@ double contact_semi_integral(const contact_model *cm);        /* the D^(-(n-1)) 
 double contact_semi_integral_per_force(const contact_model *cm); /* 1/(Gamma(n+1) k): F to it */
 
 /* The spring's stiffness K, its force being K x1^n: k for the Hertz law,
- * k Gamma(N+n)/(Gamma(N) N^n) for the G1 law on N intervals (MODEL.md §4, §7)
+ * k Gamma(N+n)/(Gamma(N) N^n) for the G1 law on N intervals (docs/model.md §4)
  * with N = g1_nodes, or n_steps (internal steps since onset) when that is 0;
  * the extrapolated G1 law replaces that ratio by g1_line_ratio_extrapolated. */
 double contact_spring_stiffness(const contact_model *cm, long n_steps);

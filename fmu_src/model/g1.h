@@ -1,6 +1,6 @@
 /* G1 (Grünwald–Letnikov) quadrature of the fractional operator D^alpha on a
  * uniform grid: a generic operator, any order alpha, any sampled function.
- * MODEL.md §3. C99, libc and libm only. */
+ * docs/model.md §3. C99, libc and libm only. */
 #ifndef FRACCONTACT_G1_H
 #define FRACCONTACT_G1_H
 

@@ -1,4 +1,4 @@
-/* A sum of exponentials for the springpot's kernel (MODEL.md §8):
+/* A sum of exponentials for the springpot's kernel (docs/model.md §6):
  *     tau^(-alpha) / Gamma(1 - alpha)  ~  eta delta(tau) + sum_i a_i exp(-b_i tau),
  * relative error at most `tolerance` for every tau in [delta, span]. The
  * terms are a generalised Maxwell (Prony) series: the fastest part of the

@@ -117,6 +117,8 @@ LIB.fc_run_batch_with_progress.argtypes = [ctypes.c_size_t, ctypes.c_void_p, cty
                                            ctypes.c_void_p]
 LIB.fc_result_free.argtypes = [ctypes.POINTER(Result)]
 LIB.fc_run_batch.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+LIB.fc_method_name.restype = ctypes.c_char_p
+LIB.fc_method_name.argtypes = [ctypes.c_void_p]  # by address, as fc_params_warning
 LIB.fc_memory_kernel.restype = ctypes.c_size_t
 LIB.fc_memory_kernel.argtypes = [ctypes.POINTER(Params), ctypes.c_size_t, ctypes.POINTER(ctypes.c_double),
                                  ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double), ctypes.c_char_p,

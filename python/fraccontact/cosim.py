@@ -16,11 +16,19 @@ Orders:
   gauss-seidel  the contact steps first, the striker then takes its force.
 
 An external force on the striker: gravity g (the striker FMU's parameter),
-which the contact FMU's proxy knows only when given g_contact = g.
+which the contact FMU's proxy knows only when given g_contact = g, or a
+spring k_s, which it knows when the master feeds its acceleration as the
+contact's input a at every step (feed_a, --feed-a).
+
+Two moving bodies: a second striker FMU instance of mass m2 and initial
+velocity v2 (along the striker's axis) takes +F where the striker takes -F;
+the contact gets v2 and m2 (docs/two_bodies.md).
 
 Used by the cosim_study report and tests/test_cosim.py; also a command:
   fraccontact cosim --step 1e-4 --coupling mass-aware --order gauss-seidel
   fraccontact cosim --step 1e-4 --coupling predictive --order libcosim
+  fraccontact cosim --step 1e-4 --k-s 1e5 --feed-a
+  fraccontact cosim --step 1e-4 --m 4.5 --v 2 --m2 2
 """
 
 import argparse
@@ -47,8 +55,8 @@ MONOLITHIC_STEP = 1e-5  # the reference's communication step (its internal steps
 # microseconds each, so this bounds a run to minutes.
 MAX_STEPS = 1_000_000
 # The variables this module reads and sets in each FMU.
-CONTACT_VARIABLES = ("law", "scene", "v", "m", "g", "coupling", "F", "F_avg", "F_avg_next", "F_peak", "E_diss",
-                     "eps", "v_striker", "x")
+CONTACT_VARIABLES = ("law", "scene", "v", "m", "v2", "m2", "a", "g", "coupling", "F", "F_avg", "F_avg_next",
+                     "F_peak", "E_diss", "eps", "v_striker", "x")
 STRIKER_VARIABLES = ("m", "v0", "g", "k_s", "F", "v", "x")
 
 
@@ -56,18 +64,27 @@ class Refused(Exception):
     """An FMU refused a value or a step: its own message, and who refused."""
 
 
-def contact_values(coupling, g_contact=0.0):
+def contact_values(coupling, g_contact=0.0, m=M, v=V0, m2=0.0, v2=0.0):
     """The contact FMU's values for a coupling: driven, closed-form Hertz,
-    the striker's mass (not with zoh) and, for F_avg_next, coupling = 2."""
-    values = {"law": 2, "scene": 2, "v": V0, "m": 0.0 if coupling == "zoh" else M, "g": g_contact}
+    the striker's mass (not with zoh), a second body's (m2 > 0) and, for
+    F_avg_next, coupling = 2."""
+    values = {"law": 2, "scene": 2, "v": v, "m": 0.0 if coupling == "zoh" else m, "g": g_contact}
+    if m2 > 0:
+        values.update(m2=m2, v2=v2)
     if coupling == "predictive":
         values["coupling"] = 2
     return values
 
 
-def striker_values(g=0.0, k_s=0.0):
-    """The striker FMU's values: the h20 striker under gravity g, held by a spring k_s."""
-    return {"m": M, "v0": V0, "g": g, "k_s": k_s}
+def striker_values(g=0.0, k_s=0.0, m=M, v=V0):
+    """The striker FMU's values: the h20 striker (or one of mass m at v) under gravity g, held by a spring k_s."""
+    return {"m": m, "v0": v, "g": g, "k_s": k_s}
+
+
+def other_acceleration(x, g_unknown, k_s, m=M):
+    """What the striker's forces other than the contact give it at its
+    position x, less the gravity the contact knows: the contact's input a."""
+    return g_unknown - k_s * x / m
 
 
 def check_order(coupling, order):
@@ -78,11 +95,14 @@ def check_order(coupling, order):
                          "a Gauss-Seidel master connects F_avg (mass-aware)")
 
 
-def energy_error(v_end, E_diss, x_end=0.0, g=0.0, k_s=0.0):
+def energy_error(v_end, E_diss, x_end=0.0, g=0.0, k_s=0.0, m=M, v=V0, m2=0.0, v2=0.0, v2_end=0.0):
     """(kinetic energy at the end + the work dissipated - gravity's work on
-    the striker + the energy in its spring) over the impact energy, less 1:
-    > 0 is energy created."""
-    return (0.5 * M * v_end ** 2 + E_diss - M * g * x_end + 0.5 * k_s * x_end ** 2) / (0.5 * M * V0 ** 2) - 1
+    the striker + the energy in its spring) over the energy at the start
+    (the striker's m at v, and a second body's m2 at v2), less 1: > 0 is
+    energy created."""
+    start = 0.5 * m * v ** 2 + 0.5 * m2 * v2 ** 2
+    end = 0.5 * m * v_end ** 2 + 0.5 * m2 * v2_end ** 2 + E_diss - m * g * x_end + 0.5 * k_s * x_end ** 2
+    return end / start - 1
 
 
 class Unit(Slave):
@@ -127,29 +147,36 @@ def finished(eps_contact):
     return eps_contact > 0
 
 
-def monolithic(contact_fmu, t_end=3e-3, H=MONOLITHIC_STEP, law=2, g=0.0):
+def monolithic(contact_fmu, t_end=3e-3, H=MONOLITHIC_STEP, law=2, g=0.0, m=M, v=V0):
     """The reference: the contact FMU's own drop test, same model and dt_max
-    (the closed-form Hertz law unless law says otherwise), its striker under
-    the acceleration g; v_end is its velocity at t_end, eps None before an
-    impact has ended."""
-    c = Unit(contact_fmu, "monolithic", {"law": law, "v": V0, "m": M, "g": g})
+    (the closed-form Hertz law unless law says otherwise), its striker of
+    mass m at v under the acceleration g; v_end is its velocity at t_end,
+    eps None before an impact has ended."""
+    c = Unit(contact_fmu, "monolithic", {"law": law, "v": v, "m": m, "g": g})
     t = 0.0
     while t < t_end - 1e-15:
         c.do_step(t, H)
         t += H
-    F_peak, eps, E_diss, v, x = c.get("F_peak", "eps", "E_diss", "v_striker", "x")
+    F_peak, eps, E_diss, v_end, x = c.get("F_peak", "eps", "E_diss", "v_striker", "x")
     c.free()
-    return dict(F_peak=F_peak, eps=eps if finished(eps) else None, E_diss=E_diss, v_end=v,
-                energy_error=energy_error(v, E_diss, x, g))
+    return dict(F_peak=F_peak, eps=eps if finished(eps) else None, E_diss=E_diss, v_end=v_end,
+                energy_error=energy_error(v_end, E_diss, x, g, m=m, v=v))
 
 
-def result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s):
-    """A co-simulation's figures; eps (from the striker's final velocity)
-    and eps_contact are None while no impact has ended: a striker still in
-    contact has no restitution to report."""
+def result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s, m=M, v=V0, m2=0.0, v2=0.0, v2_end=0.0):
+    """A co-simulation's figures; eps (from the bodies' final approach
+    speed) and eps_contact are None while no impact has ended: a striker
+    still in contact has no restitution to report. With a second body
+    (m2 > 0), its final velocity v2_end and the momentum error: the change
+    of the total momentum over the sum of the momenta's sizes at the start."""
     ended = finished(eps_contact)
-    return dict(F_peak=F_peak, eps=-v_end / V0 if ended else None, eps_contact=eps_contact if ended else None,
-                impact_ended=ended, E_diss=E_diss, v_end=v_end, energy_error=energy_error(v_end, E_diss, x_end, g, k_s))
+    figures = dict(F_peak=F_peak, eps=-(v_end - v2_end) / (v - v2) if ended else None,
+                   eps_contact=eps_contact if ended else None, impact_ended=ended, E_diss=E_diss, v_end=v_end,
+                   energy_error=energy_error(v_end, E_diss, x_end, g, k_s, m, v, m2, v2, v2_end))
+    if m2 > 0:
+        figures.update(v2_end=v2_end,
+                       momentum_error=(m * v_end + m2 * v2_end - (m * v + m2 * v2)) / (abs(m * v) + abs(m2 * v2)))
+    return figures
 
 
 def spring_reference(k_s):
@@ -162,41 +189,56 @@ def spring_reference(k_s):
 
 
 def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False, g=0.0, g_contact=0.0,
-               k_s=0.0):
-    """One co-simulation of the h20 drop, the striker under gravity g (which
-    the contact's proxy striker knows as g_contact) and held by a spring k_s
-    at its start (which the contact does not know); returns F_peak, eps (from
-    the striker's final velocity), eps_contact (the contact's own, at the
-    separation; both None before an impact has ended), the energy error and,
-    with trace, the series."""
+               k_s=0.0, feed_a=False, m=M, v=V0, m2=0.0, v2=0.0):
+    """One co-simulation of the h20 drop (or of a striker of mass m at v),
+    the striker under gravity g (which the contact's proxy striker knows as
+    g_contact) and held by a spring k_s at its start (which the contact
+    knows when feed_a: the acceleration of both, less g_contact, as its
+    input a at each step's start); with m2 > 0 against a second free body
+    of mass m2 at v2 (a striker FMU instance taking +F). Returns F_peak, eps
+    (from the final approach speed), eps_contact (the contact's own, at the
+    separation; both None before an impact has ended), the energy error,
+    with a second body its final velocity and the momentum error, and with
+    trace the series."""
     check_order(coupling, order)
-    contact = Unit(contact_fmu, "contact", contact_values(coupling, g_contact))
-    striker = Unit(striker_fmu, "striker", striker_values(g, k_s))
+    contact = Unit(contact_fmu, "contact", contact_values(coupling, g_contact, m, v, m2, v2))
+    striker = Unit(striker_fmu, "striker", striker_values(g, k_s, m, v))
+    bodies = [(striker, -1.0)]  # each body and the sign of the contact force on it
+    if m2 > 0:
+        bodies.append((Unit(striker_fmu, "body2", striker_values(m=m2, v=v2)), 1.0))
     force = FORCE[coupling]
     F_held = contact.get(force)  # before the first step: F_avg_next is F, 0 at the start
     series = []
     t, n = 0.0, 0
     while t < t_end - 1e-15:
-        v = striker.get("v")
-        contact.set(v=v)
+        inputs = dict(v=striker.get("v"))
+        if m2 > 0:
+            inputs["v2"] = bodies[1][0].get("v")
+        if feed_a:
+            inputs["a"] = other_acceleration(striker.get("x"), g - g_contact, k_s, m)
+        contact.set(**inputs)
         if order == "jacobi":
-            striker.set(F=F_held)
-            striker.do_step(t, H)
+            for body, sign in bodies:
+                body.set(F=-sign * F_held)  # the striker FMU's F pushes it back
+                body.do_step(t, H)
             contact.do_step(t, H)
             F_held = contact.get(force)
         else:
             contact.do_step(t, H)
-            striker.set(F=contact.get(force))
-            striker.do_step(t, H)
+            for body, sign in bodies:
+                body.set(F=-sign * contact.get(force))
+                body.do_step(t, H)
         n += 1
         t = n * H
         if trace:
             series.append((t, contact.get("F"), contact.get("F_avg"), striker.get("v"), striker.get("x")))
     v_end, x_end = striker.get("v", "x")
+    v2_end = bodies[1][0].get("v") if m2 > 0 else 0.0
     F_peak, E_diss, eps_contact = contact.get("F_peak", "E_diss", "eps")
     contact.free()
-    striker.free()
-    figures = result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s)
+    for body, _ in bodies:
+        body.free()
+    figures = result(F_peak, E_diss, eps_contact, v_end, x_end, g, k_s, m, v, m2, v2, v2_end)
     if trace:
         figures["series"] = series
     return figures
@@ -289,30 +331,53 @@ def main(argv=None, prog=None):
     parser.add_argument("--k-s", type=finite, default=0.0,
                         help="stiffness of a spring holding the striker where the contact begins [N/m] (default 0), "
                              "an external force the contact does not know; judged against scipy's solution")
+    parser.add_argument("--feed-a", action="store_true",
+                        help="feed the contact FMU the striker's acceleration from its spring (and from the gravity "
+                             "it does not know) as its input a at each step's start")
+    parser.add_argument("--m", type=positive, default=M, help=f"the striker's mass [kg] (default {M:g})")
+    parser.add_argument("--v", type=finite, default=V0, help=f"the striker's velocity at the start [m/s] (default {V0:g})")
+    parser.add_argument("--m2", type=finite, default=0.0,
+                        help="a second free body's mass [kg] (default 0: none, the specimen held), which takes +F; "
+                             "judged against the drop test of the reduced mass m m2/(m + m2) at v - v2")
+    parser.add_argument("--v2", type=finite, default=0.0, help="the second body's velocity at the start [m/s] (default 0)")
     args = parser.parse_args(argv)
     check_times(parser, args)
     if not args.k_s >= 0:
         parser.error(f"--k-s must be 0 or positive, not {args.k_s:g}")
+    if not args.m2 >= 0:
+        parser.error(f"--m2 must be 0 or positive, not {args.m2:g}")
+    if not args.v - args.v2 > 0:
+        parser.error(f"--v {args.v:g} and --v2 {args.v2:g}: the bodies must approach (v - v2 > 0)")
+    if (args.m2 > 0 or args.v2 != 0 or args.m != M or args.v != V0) and (args.k_s > 0 or args.gravity != 0):
+        parser.error("--m, --v, --m2, --v2 with --k-s or --gravity: there is no reference for both")
+    if args.v2 != 0 and args.m2 == 0:
+        parser.error(f"--v2 {args.v2:g} needs a second body: --m2 > 0")
     if args.k_s > 0 and args.gravity != 0:
         parser.error("--k-s with --gravity: there is no reference for both")
     if args.coupling == "predictive" and args.order == "gauss-seidel":
         parser.error("--coupling predictive (F_avg_next) is for Jacobi masters: --order jacobi or libcosim")
     args.contact, args.striker = fmu_paths(parser, args)
     forces = dict(g=args.gravity, g_contact=args.gravity if args.contact_knows_gravity else 0.0, k_s=args.k_s)
+    bodies = dict(m=args.m, v=args.v, m2=args.m2, v2=args.v2)
+    if args.order == "libcosim" and (args.feed_a or args.m2 > 0 or args.m != M or args.v != V0):
+        parser.error("--order libcosim runs the h20 striker alone, without --feed-a: use --order jacobi")
     try:
         if args.order == "libcosim":
             r = cosimulate_libcosim(args.contact, args.striker, args.step, args.coupling, args.t_end, **forces)
         else:
-            r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end, **forces)
+            r = cosimulate(args.contact, args.striker, args.step, args.coupling, args.order, args.t_end,
+                           feed_a=args.feed_a, **forces, **bodies)
         if args.k_s > 0:  # the spring keeps acting after the separation: eps is the contact's, at the separation
             ref = spring_reference(args.k_s)
             figures = dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
                            eps_error=None if r["eps"] is None else r["eps_contact"] - ref["eps"], reference=ref)
         else:
-            ref = monolithic(args.contact, t_end=args.t_end, g=args.gravity)
-            # eps of both from the striker's velocity at t_end (the same as at the separation without gravity)
+            mass = args.m * args.m2 / (args.m + args.m2) if args.m2 > 0 else args.m
+            ref = monolithic(args.contact, t_end=args.t_end, g=args.gravity, m=mass, v=args.v - args.v2)
+            # eps of both from the approach speed at t_end (the same as at the separation without gravity)
             figures = dict(r, F_peak_error=r["F_peak"] / ref["F_peak"] - 1,
-                           eps_error=None if r["eps"] is None else r["eps"] + ref["v_end"] / V0, monolithic=ref)
+                           eps_error=None if r["eps"] is None else r["eps"] + ref["v_end"] / (args.v - args.v2),
+                           monolithic=ref)
     except Refused as e:
         parser.error(str(e))
     if not r["impact_ended"]:

@@ -1,4 +1,4 @@
-"""The elastic Hertz impact in closed form (MODEL.md §2): the scales the fit,
+"""The elastic Hertz impact in closed form (docs/model.md §2): the scales the fit,
 the reports and the second implementation in scipy take their steps and
 tolerances from. A sphere of mass m meeting a half-space at v with the
 Hertz constant k reaches x_max = (5 m v^2 / (4 k))^(2/5) and the force

@@ -26,7 +26,9 @@ scipy's OptimizeResult.
                eps, t_contact, E_diss, x, x1, x2, v);
              stopped: why, "impacts", "t_end" or "receding";
              impacts, steps, k: finished impacts, internal steps, the spring
-               constant used.
+               constant used;
+             method: the method that ran, as the model names it (sdirk2,
+               esdirk54, g1_history, central; docs/model.md §16).
   Series   what simulate() returns: the columns t, F, x, x1, x2, v, E_diss
            (arrays, SI units), and run, the Run impact() gives for the same
            parameters.
@@ -244,7 +246,7 @@ def warning(**params):
 def memory_kernel(**params):
     """The compressed memory's kernel for these parameters (damper_order,
     memory_tolerance, dt_max, and whether error-controlled steps apply, which
-    fit it from min(dt_max, 1e-9 s); MODEL.md §8): (a, b, eta) with
+    fit it from min(dt_max, 1e-9 s); docs/model.md §6): (a, b, eta) with
     tau^(-alpha)/Gamma(1-alpha) ~ eta delta(tau) + sum a_i exp(-b_i tau),
     the last term the lumped spring (b = 0)."""
     p = _params(**params)
@@ -319,6 +321,7 @@ class Run(_Record):
     impacts: int      # finished impacts
     steps: int        # internal steps
     k: float          # the spring constant used (given, or derived) [N/m^n]
+    method: str       # the method that ran: sdirk2, esdirk54, g1_history or central
 
 
 @dataclass
@@ -337,14 +340,20 @@ class Series(_Record):
 STOP_WORDS = np.array([_lib.STOPS.get(i, "") for i in range(max(_lib.STOPS) + 1)])
 
 
-def _run(o, per_impact, shape=None):
+def _method(address):
+    """The method the fc_params at address runs, as the library names it."""
+    return _lib.LIB.fc_method_name(address).decode()
+
+
+def _run(o, per_impact, method, shape=None):
     """The Run of an array of fc_outcome: arrays of shape, or numbers (shape
     None, one outcome)."""
     form = (lambda a: a.item()) if shape is None else (lambda a: a.reshape(shape))
     ended = o["impacts"] > 0
     first = [form(np.where(ended, o["first"][name], np.nan)) for name in IMPACT_FIGURES]
     return Run(*first, per_impact=per_impact, end=End(*(form(o[name]) for name in END_FIGURES)),
-               stopped=form(STOP_WORDS[o["stop"]]), impacts=form(o["impacts"]), steps=form(o["steps"]), k=form(o["k"]))
+               stopped=form(STOP_WORDS[o["stop"]]), impacts=form(o["impacts"]), steps=form(o["steps"]), k=form(o["k"]),
+               method=method)
 
 
 class _Watch:
@@ -408,7 +417,8 @@ def _call_run(p, interval):
                       for i in range(r.n_impacts)]
         rows = np.ctypeslib.as_array(r.rows, shape=(r.n_rows, len(_lib.COLUMNS))).copy() if r.n_rows else \
             np.zeros((0, len(_lib.COLUMNS)))
-        return _run(np.frombuffer(bytes(r.outcome), dtype=np.dtype(_lib.Outcome)), per_impact), rows
+        return _run(np.frombuffer(bytes(r.outcome), dtype=np.dtype(_lib.Outcome)), per_impact,
+                    _method(ctypes.addressof(p))), rows
     finally:
         _lib.LIB.fc_result_free(ctypes.byref(r))
 
@@ -457,7 +467,8 @@ def impacts(**params):
         status = _lib.LIB.fc_run_batch_with_progress(len(batch), batch.ctypes.data, out.ctypes.data, progress, None)
     if status != _lib.FC_OK:
         _raise_for_case(batch, out, shape)
-    return _run(out, None, shape)
+    methods = np.array([_method(batch.ctypes.data + i * batch.itemsize) for i in range(len(batch))])
+    return _run(out, None, methods.reshape(shape), shape)
 
 
 def _index(i, shape):

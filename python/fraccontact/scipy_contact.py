@@ -1,4 +1,4 @@
-"""The contact ODE of MODEL.md §2 solved with scipy's solve_ivp: a second
+"""The contact ODE of docs/model.md §2 solved with scipy's solve_ivp: a second
 implementation, independent of the C code, for the tests and the reports.
 
     x1' = v - F/c,  v' = -(F + k_s x)/m,  x2' = F/c,  E_diss' = F^2/c,  F = k max(x1, 0)^(3/2)

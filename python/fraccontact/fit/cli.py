@@ -1,10 +1,10 @@
 """Material identification from drop tests, as the paper does it: find the
 Hertz constant k and the damper that reproduce a test's peak force and
 restitution coefficient, then the specimen's Young's modulus from k
-(MODEL.md §2, §6). Or fit them and the contact onset t0 to a whole measured
+(docs/model.md §1, §2). Or fit them and the contact onset t0 to a whole measured
 force-time curve by least squares, with their standard errors and a plot.
 The damper is the dashpot c (--damper 1, the default) or the springpot
-F = c_alpha D^alpha x2 (--damper 2, MODEL.md §7: k, c_alpha and its order
+F = c_alpha D^alpha x2 (--damper 2, docs/model.md §5: k, c_alpha and its order
 alpha, or k and c_alpha with --damper-order fixing alpha). Several drop tests
 are fitted at once from a table (--drops: height, F_max, eps per row) or
 from several curves (--curve and --height repeated, in the same order).

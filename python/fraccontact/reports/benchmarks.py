@@ -9,7 +9,7 @@
      one impact in one doStep, error-controlled against fixed steps;
   3. the bare G1 history sum of f(x) = x, N = 1e3 to 1e6, newest point and
      full grid, against the PyPI package differint, each result checked at
-     every grid point against the closed form of MODEL.md §4;
+     every grid point against the closed form of docs/model.md §4;
   4. the Python package against the C core: fraccontact.impacts against
      fraccontact-bench batch (CPU per impact), a process per impact,
      fraccontact sweep on 1 and 2 local Dask workers, a 1000-row curve fit;
@@ -151,7 +151,7 @@ LADDER_SECONDS = 2.0  # a ladder stops after a setting costing more per impact: 
 ROUNDS = 7            # head-to-head rounds of the cheapest settings
 FMU_H = 2e-3          # one doStep over the whole h20 contact (1.32 ms)
 # The FMU's settings: label, tolerance, dt_max, one-doStep impacts a round.
-# The issue names tolerance 1e-6; 5e-8 is the README's setting for the four
+# The issue names tolerance 1e-6; 5e-8 is docs/numerics.md's setting for the four
 # figures within 1e-6 (a twentieth of the target), so it is measured too.
 FMU_FIXED = "fixed: tolerance 0, dt_max 1e-7 s (the defaults)"
 FMU_SETTINGS = (("adaptive: tolerance 1e-6, dt_max 1e-3 s", 1e-6, 1e-3, 60),
@@ -528,7 +528,7 @@ def precision_section(r):
 # --- 3. the G1 history sum against differint -------------------------------------
 
 def line_g1(alpha, n, delta):
-    """The G1 value of D^alpha x at grid points n (MODEL.md §4), computed here
+    """The G1 value of D^alpha x at grid points n (docs/model.md §4), computed here
     independently of the C code: Gamma ratios directly below n = 30, and above
     Stirling's series with the O(1) terms cancelled analytically."""
     n = np.asarray(n, dtype=float)

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import atomic, fit, model, reports, sweep
 
-# The paper's h20 row (MODEL.md §6, Table 1): what was measured, and the
+# The paper's h20 row (docs/model.md §1, Table 1): what was measured, and the
 # constants the paper fitted, which are the library's defaults.
 H20 = model.defaults()
 PAPER = dict(F_peak=1004.0, eps=0.59, height=0.020, m=H20["m"], k=H20["k"], c=H20["c"], E_s=H20["E_s"])
@@ -150,7 +150,7 @@ def family_section(out):
     lines = ["## The h20 row with a springpot: a family of solutions", "",
              f"`fraccontact fit --F-peak 1004 --eps 0.59 --height 0.020 --m {PAPER['m']:g} --damper 2` "
              f"({seconds:.1f} s in-process) answers with one line and a table:", "", "```", verdict, "```", "",
-             "MODEL.md §6 gives F_max and eps at 20 mm only (the paper measured 5 to 100 mm but tabled h20 alone), "
+             "docs/model.md §1 gives F_max and eps at 20 mm only (the paper measured 5 to 100 mm but tabled h20 alone), "
              "so the springpot's three parameters meet two numbers. For each order alpha the k and c_alpha that "
              "reproduce them (least squares at that alpha, each solved from its neighbour):", "",
              "| alpha | k [N/m^1.5] | c_alpha [N s^alpha/m] | E_s [GPa] | t_contact at 20 mm [ms] | dent x2_end at "
@@ -324,6 +324,7 @@ def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     parser.add_argument("--impacts", type=int, default=4000, help="impacts for the throughput runs (default 4000)")
     args = reports.parse(parser, argv)
+    reports.pyplot()  # before the minutes of sweeps: a missing matplotlib is said at once
     with tempfile.TemporaryDirectory() as work:
         write_report(args, pathlib.Path(work))
 

@@ -34,7 +34,7 @@ HEIGHTS = np.round(np.arange(5, 101, 5) * 1e-3, 6)   # the paper's campaign [m]
 TOLERANCES = [10.0 ** -e for e in range(2, 13)]
 KERNEL_ALPHAS = (0.25, 0.5, 0.75)
 SPAN = 1e3                                           # the compressed kernel's span (CONTACT_MEMORY_SPAN) [s]
-PUBLISHED = {1e-6: (32, 37, 48, 59), 1e-9: (45, 53, 69, 85), 1e-12: (58, 68, 90, 111)}  # MODEL.md §8
+PUBLISHED = {1e-6: (32, 37, 48, 59), 1e-9: (45, 53, 69, 85), 1e-12: (58, 68, 90, 111)}  # docs/model.md §6
 PUBLISHED_RATIOS = (1e-3, 1e-4, 1e-6, 1e-8)
 COST_STEPS = (1e3, 3e3, 1e4, 3e4, 1e5)               # internal steps of one impact, for the cost per step
 LADDER = (8e-7, 4e-7, 2e-7, 1e-7)                    # dt_max of the memory-1 reference (N <= 14 000)
@@ -86,7 +86,7 @@ def riemann_liouville(ts, F, alpha, at):
 
 
 def exact_kernel(tau, alpha):
-    """The springpot's kernel tau^(-alpha)/Gamma(1 - alpha) (MODEL.md §8)."""
+    """The springpot's kernel tau^(-alpha)/Gamma(1 - alpha) (docs/model.md §6)."""
     return np.power(tau, -alpha) / math.gamma(1.0 - alpha)
 
 
@@ -638,7 +638,7 @@ def section_curves(series, omega, one):
     lines += ["", "E_diss, the work on the damper (the integral of F dx2), is the loop's area and should equal the "
               "striker's lost kinetic energy at separation, where the spring holds no energy (x1 = 0). It does to "
               "about 1e-4 only: the default G1 spring (law 1) is k x1^n Gamma(N+n)/(Gamma(N) N^n) with N the steps "
-              "since onset (MODEL.md §4), a stiffness that changes during the contact, so the spring is not exactly "
+              "since onset (docs/model.md §4), a stiffness that changes during the contact, so the spring is not exactly "
               "conservative. With the closed-form Hertz spring (law 2) the balance holds to "
               f"{e(abs(hertz[0]), 1)} (dashpot) and {e(abs(hertz[1]), 1)} (springpot 0.5). The springpot at alpha = 1 "
               f"(c_1 = c) against the dashpot, every internal step ({one['rows'][0]} and {one['rows'][1]} rows): "
@@ -735,7 +735,7 @@ def section_recovery(rec, sens, sc):
               "on the power law (the contact's length still matters); by 1 s it is.", "",
               "What sets that error: the recovery's own time steps. Out of contact a recovering springpot steps at "
               "a fraction f = 64 dt_max / t_contact (at most 1/16) of the time since separation (RECOVERY_STEPS in "
-              "contact.c), so that the recovery's O(f^2) error falls with dt_max like the contact's; x2 at 100 s "
+              "fmu_src/model/control.c), so that the recovery's O(f^2) error falls with dt_max like the contact's; x2 at 100 s "
               "against the exact convolution of each run's own force (alpha 0.5, c_alpha 3e5):", "", "| memory_tolerance | dt_max [s] | contact steps | recovery steps to 100 s | "
               "x2 / (I^alpha F / c_alpha) - 1 at 100 s |", "|---|---|---|---|---|"]
     for r in sens:
@@ -894,7 +894,7 @@ def section_memory(k, agree, lad):
                               for b in k["broken"])
                   + f". `fraccontact.impact(damper=2, damper_order={k['broken'][0]['lo']:g}, memory_tolerance="
                   f"{e(k['broken'][0]['tol'], 0)})` says: \"{k['broken'][0]['failure']}\"."]
-    lines += ["", "Against the published counts for tau^(-1/2) (MODEL.md §8, Jiang et al. 2017), the same alpha = 0.5 "
+    lines += ["", "Against the published counts for tau^(-1/2) (docs/model.md §6, Jiang et al. 2017), the same alpha = 0.5 "
               "kernel with dt_max = delta/T x 1000 s:", "",
               "| tolerance | delta/T | published M | M here | kernel error here |", "|---|---|---|---|---|"]
     for r in k["published"]:
@@ -919,7 +919,7 @@ def section_memory(k, agree, lad):
                      f"{f.eps:.9f} | {c.eps:.9f} | {e(rel(c.eps, f.eps))} |")
     lines += ["", "Observed order of the F_peak difference: " + ", ".join(f"{x:.2f}" for x in order(diffs, LADDER))
               + ". Both memories step the same grid and use the same G1 spring, whose first-order error "
-              "(k x1^n Gamma(N+n)/(Gamma(N) N^n), N = steps since onset, MODEL.md §4) moves F_peak by "
+              "(k x1^n Gamma(N+n)/(Gamma(N) N^n), N = steps since onset, docs/model.md §4) moves F_peak by "
               f"{e(rel(d[LADDER[-1]]['comp'].F_peak, d[LADDER[-2]]['comp'].F_peak))} between the last two rows: "
               "it is common to both and cancels in their difference.", "",
               "Each memory's own error, with the closed-form Hertz spring (law 2) and the compressed kernel at "
@@ -987,9 +987,9 @@ def write_report(args):
     lines = ["# Fractional damping: the springpot", "",
              "Regenerate: `scripts/report fractional_damping` (writes this file and `fractional_damping_*.png`; "
              f"this run: {cpu:.0f} s of CPU, {wall:.0f} s wall, measurements only).", "",
-             "The dashpot of the paper's model (MODEL.md §2) replaced by a springpot, F = c_alpha D^alpha x2 "
-             "(MODEL.md §7; `damper = 2`, `damper_order` alpha, `c_alpha`), in series with the Hertz spring. Its "
-             "memory is the compressed sum of exponentials (`memory = 2`, the default, MODEL.md §8) unless a row "
+             "The dashpot of the paper's model (docs/model.md §2) replaced by a springpot, F = c_alpha D^alpha x2 "
+             "(docs/model.md §5; `damper = 2`, `damper_order` alpha, `c_alpha`), in series with the Hertz spring. Its "
+             "memory is the compressed sum of exponentials (`memory = 2`, the default, docs/model.md §6) unless a row "
              "says memory 1 (the literal G1 history sum). Every figure below is measured by this run, in-process "
              "on the C library (`fraccontact.impact`, `impacts`, `simulate`, `memory_kernel`) and, for the state "
              "sizes, through the FMU with fmpy.", ""]

@@ -16,7 +16,7 @@ from ..options import positive
 
 plt = reports.pyplot()
 
-PAPER = {"F_peak": 1004.0, "eps": 0.59}  # MODEL.md §6, Table 1, h20
+PAPER = {"F_peak": 1004.0, "eps": 0.59}  # docs/model.md §1, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
 OUTPUTS = ["F", "x", "x1", "x2", "v_striker", "eps", "F_peak", "E_diss", "contact"]
 # fmpy holds every row as a tuple of Python floats until the end of a run, and the CSV writes them all:

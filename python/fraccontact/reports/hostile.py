@@ -43,7 +43,7 @@ REALS = ["v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k", "c", "dt_max", "g", "
 VALUES = {"0": 0.0, "negative": -1.0, "denormal": 5e-324, "huge": 1e300, "NaN": math.nan, "+Inf": math.inf,
           "-Inf": -math.inf}
 OUTPUTS = ["F", "F_avg", "F_avg_next", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps", "semi_integral"]
-# The library's defaults (DESIGN.md's interface table): the paper's h20 test.
+# The library's defaults: the paper's h20 test (docs/model.md §1).
 DEFAULTS = {name: model.defaults()[name] for name in REALS}
 GAMMA_5_2 = 0.75 * math.sqrt(math.pi)
 DEFAULT_STEPS = [["step", 1e-5]] * 200          # 2 ms: the h20 impact (1.3 ms) and some flight
@@ -65,7 +65,7 @@ TABLE = {
                                 "c v^2 without inertia: no run can have finite outputs, whatever m becomes")},
     "m": {"0": (REFUSED_INIT, "the drop test needs a mass (0 is the driven scene's 'no inertia')"),
           "negative": (REFUSED_SET, "a mass is >= 0"),
-          "denormal": (REFUSED_SET, "1/m would overflow (README)"),
+          "denormal": (REFUSED_SET, "1/m would overflow (docs/variables.md)"),
           "huge": ("constant rate", "valid: a striker of 1e300 kg does not slow down, a constant-rate drive")},
     "R": {"0": (REFUSED_SET, "R > 0"), "negative": (REFUSED_SET, "R > 0"),
           "denormal": ("reference", MATERIAL), "huge": ("reference", MATERIAL)},
@@ -77,14 +77,14 @@ TABLE = {
             "denormal": ("reference", MATERIAL), "huge": ("reference", MATERIAL)},
     "nu_s": {"0": ("reference", MATERIAL), "negative": (REFUSED_SET, "a Poisson ratio lies in (-1, 0.5]"),
              "denormal": ("reference", MATERIAL), "huge": (REFUSED_SET, "a Poisson ratio lies in (-1, 0.5]")},
-    "k": {"0": ("reference", "valid: k derived from R, E_i, nu_i, E_s, nu_s (MODEL.md §2)"),
-          "negative": (REFUSED_SET, "k >= 0"), "denormal": (REFUSED_SET, "1/k would overflow (README)"),
+    "k": {"0": ("reference", "valid: k derived from R, E_i, nu_i, E_s, nu_s (docs/model.md §2)"),
+          "negative": (REFUSED_SET, "k >= 0"), "denormal": (REFUSED_SET, "1/k would overflow (docs/variables.md)"),
           "huge": ("rigid spring", "valid: a rigid spring, the dashpot alone stops the striker")},
     "c": {"0": (REFUSED_SET, "c > 0"), "negative": (REFUSED_SET, "c > 0"),
-          "denormal": (REFUSED_SET, "1/c would overflow (README)"),
+          "denormal": (REFUSED_SET, "1/c would overflow (docs/variables.md)"),
           "huge": ("elastic Hertz", "valid: a rigid dashpot, the elastic Hertz impact")},
     "dt_max": {"0": ("reference", "valid: the default, fixed steps of 1e-7 s"), "negative": (REFUSED_SET, "dt_max >= 0"),
-               "denormal": (REFUSED_SET, "dt_max must be normal (README)"),
+               "denormal": (REFUSED_SET, "dt_max must be normal (docs/variables.md)"),
                "huge": ("reference", "valid: the internal steps are the 1e-5 s communication steps")},
     "g": {"0": ("reference", "no gravity (the default)"),
           "negative": ("reference", "valid: pulls the striker away; free flight after the rebound"),
@@ -123,7 +123,7 @@ def cases():
     yield "communication step 1e-15 s", case("reference", "valid: ten steps of 1e-15 s, then the h20 test",
                                              steps=[["step", 1e-15]] * 10 + DEFAULT_STEPS)
     yield "communication step 1e3 s", case("one long step", "valid: the impact's internal steps, then free flight "
-                                                            "in one exact step (README)", steps=[["step", 1e3]])
+                                                            "in one exact step (docs/numerics.md)", steps=[["step", 1e3]])
     yield "communication step 1e3 s, dt_max 1 s", case(
         "one long step", "valid: the whole impact inside one internal step", values={"dt_max": 1.0},
         steps=[["step", 1e3]])
@@ -160,7 +160,7 @@ def same(a, b):
 
 def run_case_in(s, case):
     """Runs one case on s, a fresh instance not yet in initialization mode
-    (tests/fmu_driver.Slave). Returns what was observed: the verdict reached,
+    (tests/fmu_driver.py's Slave). Returns what was observed: the verdict reached,
     the message, the outputs after every communication step (trace), the
     warnings, and after a refusal whether the instance stayed usable."""
     from fmpy.fmi1 import FMICallException
@@ -312,7 +312,7 @@ def judge(name, case, r, solve):
 
 def output_identities(j, case, r):
     """What the outputs owe each other at every communication point, in any
-    run: F = Gamma(5/2) k semi_integral (MODEL.md §3: the force is the
+    run: F = Gamma(5/2) k semi_integral (docs/model.md §3: the force is the
     spring constant times the semi-integral); the dashpot carries the
     contact force, so the step's impulse F_avg H is c times x2's increase;
     in contact x = x1 + x2. Rounding only: rel 1e-12, and for the impulse
@@ -340,7 +340,7 @@ def params(case):
 
 
 def hertz_k(p):
-    """k from the materials, MODEL.md §2."""
+    """k from the materials, docs/model.md §2."""
     return hertz.k_from_materials(p["R"], p["E_i"], p["nu_i"], p["E_s"], p["nu_s"])
 
 
@@ -354,7 +354,7 @@ def reference(solve, *args):
 def scheme_tolerance(N, h, T):
     """Relative error allowed of the FMU's default scheme against an exact
     solution of the contact ODE. The G1 law's force is Hertz's times
-    1 + 3/(8n) + O(n^-2) n internal steps after contact onset (MODEL.md §4).
+    1 + 3/(8n) + O(n^-2) n internal steps after contact onset (docs/model.md §4).
     Results integrate it over the contact: E_diss, quadratic in the force,
     errs by 2 * 3/(8n) averaged with the weight F^2 ~ n^3 of a loading
     force (F ~ t^(3/2)), that is 1/N for N steps from onset to the force's
@@ -485,7 +485,7 @@ def check_rigid_spring(j, case, r, solve):
 
 
 def check_elastic_hertz(j, case, r, solve):
-    """c = 1e300: the elastic Hertz impact (MODEL.md §2):
+    """c = 1e300: the elastic Hertz impact (docs/model.md §2):
     x_max = (5 m v0^2 / (4 k))^(2/5), F_peak = k x_max^(3/2), eps = 1,
     t_c = (4/5) B(2/5, 1/2) x_max / v0; the separation time read from the free flight
     that follows (x - x2 = v (t - t_sep))."""

@@ -68,8 +68,11 @@ def mutant(name, category, change, claim, *edits):
     return Mutant(name, category, change, claim, tuple(edits))
 
 
-C, G1, MODEL, STATE = \
-    "fmu_src/model/contact.c", "fmu_src/model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c"
+G1, MODEL, STATE, INSTANCE = \
+    "fmu_src/model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
+# The model's files (fmu_src/model/): one responsibility each.
+PARAMETERS, LIFE, STAGE, SDIRK2, EVENTS, EVOLVE = ("fmu_src/model/" + f for f in (
+    "parameters.c", "model.c", "stage.h", "sdirk2.c", "events.c", "evolve.c"))
 CONTACT_H = "fmu_src/model/contact.h"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
@@ -79,10 +82,10 @@ MUTANTS = [
     mutant("hertz-exponent", "force laws", "implicit stage: F = K x1^(3/2 + 2e-12)",
            "exponent +2e-12: F off by 2.2e-11 to 2.9e-11 at the driven test's x1 = 5e-7..2e-5 m; "
            "DRIVEN_RTOL 1e-11 (test_fmu_physics::test_driven_hertz_law_is_k_x1_to_the_3_2)",
-           (C, "F = K * s * s * s;", "F = K * s * s * s * pow(s, 4e-12);")),
+           (STAGE, "return K * s * *X;", "return K * s * *X * pow(s, 4e-12);")),
     mutant("hertz-constant", "force laws", "k from the materials ×(1 + 3e-15)",
            "3e-15; test_contact test_hertz_constant rel 1e-15",
-           (C, "return 4.0 / 3.0 * E_star * sqrt(R);", "return 4.0 / 3.0 * E_star * sqrt(R) * (1.0 + 3e-15);")),
+           (PARAMETERS, "return 4.0 / 3.0 * E_star * sqrt(R);", "return 4.0 / 3.0 * E_star * sqrt(R) * (1.0 + 3e-15);")),
     mutant("g1-ratio-tgamma", "force laws", "G1 ratio Γ(N+3/2)/(Γ(N) N^(3/2)), N < 30 branch, ×(1 + 3e-14)",
            "3e-14; test_g1 test_line_ratio rel 1e-14 against extended-precision lgamma",
            (G1, "return tgamma(N + a) / (tgamma(N) * pow(N, a));",
@@ -94,7 +97,7 @@ MUTANTS = [
     mutant("gamma-5-2", "force laws", "the constant Γ(5/2) ×(1 + 3e-15) (it scales the semi-integral)",
            "3e-15; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms: "
            "d semi_integral/dt = dF/dt / (Γ(5/2) k) rel 1e-15",
-           (C, "#define GAMMA_5_2 1.329340388179137", "#define GAMMA_5_2 (1.329340388179137 * (1.0 + 3e-15))")),
+           (LIFE, "#define GAMMA_5_2 1.329340388179137", "#define GAMMA_5_2 (1.329340388179137 * (1.0 + 3e-15))")),
     mutant("richardson-odd-N", "force laws", "extrapolated G1 ratio: M = ceil(N/2) instead of floor(N/2) for odd N > 1",
            STRUCTURAL + "; the FMU's law 3 meets odd N at every other step since onset",
            (G1, "double M = floor(0.5 * N);", "double M = N > 1.0 ? ceil(0.5 * N) : 0.0;")),
@@ -123,47 +126,50 @@ MUTANTS = [
             "- pow(2.0 * delta, -alpha) * (1.0 + 4e-13) * weighted_history(w, f, n, 2);")),
     mutant("g1-N-off-by-one", "G1 weights and sums", "the G1 law counts N = steps since onset + 2 (not + 1)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error, DRIVEN_RTOL 1e-11",
-           (C, "K = contact_spring_stiffness(cm, s->n + 1);", "K = contact_spring_stiffness(cm, s->n + 2);")),
+           (EVOLVE, "K = spring_stiffness(cm, s->n + 1);\n        J = sdirk_step(",
+            "K = spring_stiffness(cm, s->n + 2);\n        J = sdirk_step(")),
     # ------------------------------------------------------------ time scheme
     mutant("sdirk-gamma", "time scheme", "SDIRK γ = (1 - 1/√2)(1 + 1e-4): first order",
            "measured: per-impact figures off by 1.5e-7 from the GSL reference; "
            "test_solver::test_per_impact_figures_against_the_reference rel 1e-7",
-           (C, "#define SDIRK_GAMMA 0.29289321881345248",
+           (SDIRK2, "#define SDIRK_GAMMA 0.29289321881345248",
             "#define SDIRK_GAMMA (0.29289321881345248 * (1.0 + 1e-4))")),
     mutant("sdirk-impulse-weight", "time scheme", "the step's impulse h((1-γ)F1 + γ F2(1 + 1e-11)), which moves x2",
            "x2 off by ~3e-12; momentum identity x2 = m v0 (1 + eps)/c rel 1e-12 (test_contact, "
            "test_fmu_physics::test_drop_momentum_identity)",
-           (C, "impulse = hb * F1 + hg * F2;", "impulse = hb * F1 + hg * F2 * (1.0 + 1e-11);")),
+           (SDIRK2, "impulse = hb * F1 + hg * F2;", "impulse = hb * F1 + hg * F2 * (1.0 + 1e-11);")),
     mutant("sdirk-dissipation", "time scheme", "each step's dissipation J²/(c h) ×(1 + 2e-8)",
            "2e-8; test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
            "E_diss = m v0² (1 - eps²)/2 rel 1e-8",
-           (C, "impulse * impulse * inv_c / h : 0.0);", "impulse * impulse * inv_c / h * (1.0 + 2e-8) : 0.0);")),
+           (SDIRK2, "impulse * impulse * cm->inv_c / h : 0.0);",
+            "impulse * impulse * cm->inv_c / h * (1.0 + 2e-8) : 0.0);")),
     mutant("step-count", "time scheme", "H = n dt_max takes n + 1 internal steps (ceil forgives no ulp)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
            "N = 10 steps per 1 us",
-           (C, "(1.0 - 1e-12)));", "(1.0 + 1e-12)));")),
+           (EVOLVE, "(1.0 - 1e-12)));", "(1.0 + 1e-12)));")),
     # ----------------------------------------------------------------- events
     mutant("onset-location", "events", "contact onset inside a free-flight step: time ×(1 + 3e-14)",
            "3e-14; test_solver::test_free_flight_is_one_exact_step: t_onset, v_onset rel 1e-14",
-           (C, "return fmin(fmax(t, 0.0), h);", "return fmin(fmax(t * (1.0 + 3e-14), 0.0), h);")),
+           (EVENTS, "return fmin(fmax(t, 0.0), h);", "return fmin(fmax(t * (1.0 + 3e-14), 0.0), h);")),
     mutant("separation-location", "events", "separation located where x1 = -1e-10 m instead of 0",
            "t_contact +2.1e-7 (1e-10 m at 0.36 m/s over 1.32 ms); "
            "test_solver::test_per_impact_figures_against_the_reference rel 1e-7",
-           (C, "return s->x1;", "return s->x1 + 1e-10;"),
-           (C, "separates = !(trial.x1 > 0.0)", "separates = !(trial.x1 + 1e-10 > 0.0)"),
-           (C, "tau = event_time(cm, s, h, K, indentation, trial.x1, &trial);",
-            "tau = event_time(cm, s, h, K, indentation, trial.x1 + 1e-10, &trial);")),
+           (EVENTS, "return s->x1;", "return s->x1 + 1e-10;"),
+           (EVOLVE, "is not one. */\n        separates = !(trial.x1 > 0.0)",
+            "is not one. */\n        separates = !(trial.x1 + 1e-10 > 0.0)"),
+           (EVENTS, "return event_time(cm, s, h, K, indentation, trial->x1, 1e-15",
+            "return event_time(cm, s, h, K, indentation, trial->x1 + 1e-10, 1e-15")),
     mutant("peak-in-step", "events", "F_peak sampled at step ends only (the peak inside a step dropped)",
-           STRUCTURAL + "; ~(π h / t_c)²/8 ~ 7e-9 at dt 1e-7 (contact.c: more than the scheme's error)",
-           (C, "return at.F > end->F ? at.F : end->F;", "return end->F;")),
+           STRUCTURAL + "; ~(π h / t_c)²/8 ~ 7e-9 at dt 1e-7 (events.c, force_at_turn: more than the scheme's error)",
+           (EVENTS, "return at.F > end->F ? at.F : end->F;", "return end->F;")),
     # ---------------------------------------------------------- proxy striker
     mutant("proxy-gravity", "proxy striker", "the driven scene's proxy striker ignores g",
            STRUCTURAL + "; test_readme::test_the_readme_master_loop_is_the_drop_test with g, bit-exact "
            "drop vs driven (test_fmu_coupling)",
-           (C, "cm->accel = m > 0.0 ? cm->p.g : slope;", "cm->accel = m > 0.0 ? 0.0 : slope;")),
+           (LIFE, "cm->accel = m > 0.0 ? cm->p.g : slope;", "cm->accel = m > 0.0 ? 0.0 : slope;")),
     mutant("proxy-mass", "proxy striker", "the proxy striker's 1/m one ulp high",
            "1 ulp; test_fmu_coupling::test_mass_aware_coupling_with_an_exact_master_is_the_drop_test: bit for bit",
-           (C, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
+           (LIFE, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
     mutant("striker-velocity", "proxy striker", "striker FMU: v += H a (1 + 2e-12)",
            "v off by 2.9e-13 after 100 steps; test_striker_fmu::test_motion_under_a_held_force_is_the_parabola "
            "v rel 1e-13",
@@ -171,30 +177,30 @@ MUTANTS = [
     # -------------------------------------------------------- gravity and gap
     mutant("gravity-sign", "gravity and gap", "the drop test's gravity points away from the specimen",
            STRUCTURAL + "; test_contact test_gap_and_gravity, test_solver free fall",
-           (C, "cm->accel = p->g;", "cm->accel = -p->g;")),
+           (LIFE, "cm->accel = p->g;", "cm->accel = -p->g;")),
     mutant("gravity-scale", "gravity and gap", "the drop test's g ×(1 + 5e-14)",
            "t_onset, v_onset off by 2.5e-14; test_solver::test_free_flight_is_one_exact_step rel 1e-14",
-           (C, "cm->accel = p->g;", "cm->accel = p->g * (1.0 + 5e-14);")),
+           (LIFE, "cm->accel = p->g;", "cm->accel = p->g * (1.0 + 5e-14);")),
     mutant("gap-ignored", "gravity and gap", "gap0 ignored: the striker starts on the specimen",
            STRUCTURAL + "; test_contact test_gap_and_gravity onset time rel 1e-12",
-           (C, "cm->s.x1 = -p->gap0;", "cm->s.x1 = 0.0;")),
+           (LIFE, "cm->s.x1 = -p->gap0;", "cm->s.x1 = 0.0;")),
     mutant("gap-scale", "gravity and gap", "gap0 ×(1 + 5e-14)",
            "t_onset, v_onset off by 2.5e-14; test_solver::test_free_flight_is_one_exact_step rel 1e-14",
-           (C, "cm->s.x1 = -p->gap0;", "cm->s.x1 = -p->gap0 * (1.0 + 5e-14);")),
+           (LIFE, "cm->s.x1 = -p->gap0;", "cm->s.x1 = -p->gap0 * (1.0 + 5e-14);")),
     # ------------------------------------------------------- the state's CRC
     mutant("crc-check-skipped", "state CRC", "a state's payload checksum is not checked",
            STRUCTURAL + "; test_fmu_state::test_damaged_states_are_refused[corrupted]",
-           (STATE, "if (serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))",
+           (INSTANCE, "if (serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))",
             "if (0 && serial_get_u32(b + 16) != serial_crc32(b + STATE_HEADER, payload))")),
     mutant("crc-range-short", "state CRC", "the checksum (written and checked) leaves out the payload's last 8 bytes",
            STRUCTURAL + "; a damaged last field would pass",
-           (STATE, "serial_put_u32(b + 16, serial_crc32(p, payload));",
+           (INSTANCE, "serial_put_u32(b + 16, serial_crc32(p, payload));",
             "serial_put_u32(b + 16, serial_crc32(p, payload - 8));"),
-           (STATE, "serial_crc32(b + STATE_HEADER, payload))", "serial_crc32(b + STATE_HEADER, payload - 8))")),
+           (INSTANCE, "serial_crc32(b + STATE_HEADER, payload))", "serial_crc32(b + STATE_HEADER, payload - 8))")),
     mutant("crc-guid-unchecked", "state CRC", "a state's GUID checksum is not checked (another FMU's state)",
            STRUCTURAL + "; test_fmu_state::test_damaged_states_are_refused[another FMU]",
-           (STATE, "if (serial_get_u32(b + 8) != serial_crc32(",
-            "if (0 && serial_get_u32(b + 8) != serial_crc32(")),
+           (INSTANCE, "if (serial_get_u32(b + 8) != token_crc())",
+            "if (0 && serial_get_u32(b + 8) != token_crc())")),
     mutant("crc-polynomial", "state CRC", "CRC-32C's polynomial instead of CRC-32's (zlib's)",
            STRUCTURAL + "; the state tests re-checksum with zlib.crc32",
            ("fmu_src/glue/serial.c", "0xEDB88320u", "0x82F63B78u")),
@@ -219,14 +225,14 @@ MUTANTS = [
            "3e-14; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms rel 1e-14",
            (MODEL, "*value = F_rate * contact_semi_integral_per_force(cm); break;",
             "*value = F_rate * contact_semi_integral_per_force(cm) * (1.0 + 3e-14); break;")),
-    mutant("F-rate", "output scaling", "dF/dt = 1.5 (1 + 2e-11) K sqrt(x1) x1'",
+    mutant("F-rate", "output scaling", "dF/dt = n (1 + 2e-11) K x1^(n-1) x1'",
            "2e-11; test_fmu_coupling::test_output_derivatives_in_the_driven_scene_are_the_closed_forms "
            "dF/dt rel 1e-11",
-           (C, "*F_rate = x1 > 0.0 ? 1.5 * contact_spring_stiffness",
-            "*F_rate = x1 > 0.0 ? 1.5 * (1.0 + 2e-11) * contact_spring_stiffness")),
+           (LIFE, "*F_rate = x1 > 0.0 ? n * contact_spring_stiffness",
+            "*F_rate = x1 > 0.0 ? n * (1.0 + 2e-11) * contact_spring_stiffness")),
     mutant("eps-output", "output scaling", "restitution eps = -v_end/v_onset ×(1 + 3e-14)",
            "3e-14; test_fmu_compliance::test_every_variable_is_read_or_written eps rel 1e-14",
-           (C, "s->eps = s->v_onset > 0.0 ? -v / s->v_onset : 0.0;",
+           (EVENTS, "s->eps = s->v_onset > 0.0 ? -v / s->v_onset : 0.0;",
             "s->eps = s->v_onset > 0.0 ? -v / s->v_onset * (1.0 + 3e-14) : 0.0;")),
     # ------------------------------------------------------------ serialization
     mutant("state-drop-F_peak", "serialization", "F_peak left out of the state's field table (FMU state, finiteness)",
@@ -468,7 +474,7 @@ def section(results, started, seconds, jobs, source, left_out):
     errors = [r.mutant.name for r in results if r.verdict == "ERROR"]
     lines = [BEGIN, "## Mutation testing", "",
              "Regenerate: `scripts/report mutation` (this section only; `--list` shows the mutants, "
-             "`--only NAME...` re-runs some without writing here). `scripts/mutation.py` copies the working tree "
+             "`--only NAME...` re-runs some without writing here). `python/fraccontact/reports/mutation.py` copies the working tree "
              "(tracked and untracked files) to a scratch directory, applies each mutant there (each edit's original "
              "text must occur exactly once in its file, or the run stops: the source moved), rebuilds, and runs the "
              "C tests (ctest, stopping at the first failure) and then `pytest -x` (files in alphabetical order, "

@@ -28,7 +28,7 @@ QUANTITIES = ("F_peak", "eps", "t_contact", "x2", "E_diss", "v")
 # run's error over its tolerance).
 C2 = dict(F_peak=0.3, eps=0.62, t_contact=1.0, x2=1.2, E_diss=3.6, v=0.62)
 # The G1 law with N = n steps since onset is Hertz with the stiffness
-# k (1 + 3/(8n) + O(n^-2)) (MODEL.md §4): at time t the relative error is
+# k (1 + 3/(8n) + O(n^-2)) (docs/model.md §4): at time t the relative error is
 # 3 dt / (8 t), a first-order error in dt/T. For the elastic peak force,
 # F_max ~ K^(2/5) with the error 3/(8n) at the peak, n = t_c / (2 dt), gives
 # D ~ 0.4 * 0.75 = 0.30. D1 is twice the largest the convergence study
@@ -73,8 +73,8 @@ LAWS = ("g1", "hertz", ADAPTIVE)
 # C2 (dt/T)^2: every accepted step's embedded error estimate is below
 # `tolerance` relative to the elastic indentation L (the larger of x1 and
 # x1 at the contact's peak force) for x1 and x2 and relative to the speed S
-# (the larger of |v| and v_onset) for v (fmu_src/model/contact.c,
-# esdirk_step), and the separation is located to a tenth of the tolerance
+# (the larger of |v| and v_onset) for v (fmu_src/model/esdirk54.c,
+# esdirk_step_of), and the separation is located to a tenth of the tolerance
 # of the contact time. The 5th-order solution is propagated, whose local
 # error is below the 4th-order estimate's, and over an impact (at most half
 # a damped oscillation) the motion hardly amplifies errors, so a figure's
@@ -116,7 +116,7 @@ def hertz_k(E_s):
 
 def g1_ratio(N):
     """Gamma(N + 3/2) / (Gamma(N) N^(3/2)), the G1 law's stiffness over
-    Hertz's on N intervals (MODEL.md §4); >= 1 for every N."""
+    Hertz's on N intervals (docs/model.md §4); >= 1 for every N."""
     return math.exp(math.lgamma(N + 1.5) - math.lgamma(N) - 1.5 * math.log(N))
 
 

@@ -21,7 +21,7 @@ from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 # spring law's own first-order error (checked by the dashpot's matrix) stays
 # out of the springpot's figures.
 
-OMEGA = 2400.0  # [rad/s] the h20 impact's frequency pi/t_c (MODEL.md §7)
+OMEGA = 2400.0  # [rad/s] the h20 impact's frequency pi/t_c (docs/model.md §1)
 MEMORY1_STEPS = 50000
 X_REF = hertz.indentation(H20["k"], H20["m"], H20["v"])  # the h20 Hertz impact's x_max
 BASE = dict(alpha=0.5, mult=1.0, n=1.5, v0=H20["v"], m=H20["m"], dt=model.step_limit(), g=0.0, gap0=0.0, impacts=1,

@@ -1,0 +1,279 @@
+/* ESDIRK 5(4), the error-controlled steps (docs/model.md §12): Kvaerno's
+ * method (A. Kvaerno, Singly diagonally implicit Runge-Kutta methods with an
+ * explicit first stage, BIT 44 (2004) 489-502), SUNDIALS ARKODE's
+ * ARKODE_KVAERNO_7_4_5, its tableau below; and the springpot's compressed
+ * memory in its stages (§6). */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "stage.h"
+
+/* Kvaerno's ESDIRK of order 5 with an embedded solution of order 4: an
+ * explicit first stage, then six implicit stages of one diagonal gamma. Both solutions are L-stable and
+ * stiffly accurate: the step's end is its last stage, the embedded
+ * solution its sixth, so that their difference estimates the step's error
+ * at no extra cost, and a step far too long for the motion damps it rather
+ * than reflecting it. Its order keeps the steps of a tight tolerance few
+ * (docs/model.md §12). */
+#define ESDIRK_STAGES 7
+#define ESDIRK_EMBEDDED 5
+#define ESDIRK_GAMMA 0.26
+static const double esdirk_a[ESDIRK_STAGES][ESDIRK_STAGES] = {
+    {0.0},
+    {ESDIRK_GAMMA, ESDIRK_GAMMA},
+    {0.13, 0.8403332099679080963, ESDIRK_GAMMA},
+    {0.2237196147832050559, 0.4767553231979969983, -0.06470895363112615134, ESDIRK_GAMMA},
+    {0.1664856432324832153, 0.1045001884159172041, 0.03631482272098715162, -0.1309070445107399857, ESDIRK_GAMMA},
+    {0.1385564023126822495, 0.0, -0.04245337201752043099, 0.02446657898003141966, 0.6194303907248067618,
+     ESDIRK_GAMMA},
+    {0.1365975117764029144, 0.0, -0.05496908796538376712, -0.04118626728321046868, 0.6299330489901640319,
+     0.06962479448202728949, ESDIRK_GAMMA}};
+
+/* The elastic indentation at the contact's peak force so far, kept for the
+ * force it was derived from. */
+static double peak_indentation(contact_model *cm, double K, double F_peak)
+{
+    if (F_peak != cm->peak_force_seen) {
+        cm->peak_force_seen = F_peak;
+        cm->peak_length = K > 0.0 ? pow(F_peak / K, 1.0 / cm->p.spring_exponent) : 0.0;
+    }
+    return cm->peak_length;
+}
+
+/* The springpot's compressed memory in the ESDIRK stages of a step of
+ * length h, as in the SDIRK steps: with z_k the damper's rate x2' at stage
+ * k, each implicit stage i has the modes
+ *     phi_i = d (E_i + gamma h z_i),   d = 1/(1 + gamma h b),
+ *     E_i = phi_n + h sum_{k<i} a_ik (z_k - b phi_k),
+ * so its force c_alpha (eta z_i + sum a phi_i) is A_i + z_i / inv_B: the
+ * memory's pull A_i = c_alpha sum a d E_i and the viscosity
+ * 1/inv_B = c_alpha (eta + gamma h sum a d), one scalar root per stage
+ * still. Stage 0 is the step's start. The stages' modes are kept for the
+ * stages that follow: on the stack (10 kB), no allocation. */
+typedef struct {
+    double d[CONTACT_MAX_MODES];
+    double phi[ESDIRK_STAGES][CONTACT_MAX_MODES];
+} esdirk_memory;
+
+/* The step's d and the stage 0 modes; returns inv_B. */
+static double esdirk_memory_begin(const contact_model *cm, double h, esdirk_memory *mem)
+{
+    const contact_modes *m = &cm->modes;
+    const double hg = ESDIRK_GAMMA * h;
+    double sum_p = 0.0;
+    size_t j;
+    for (j = 0; j < m->modes; j++) {
+        mem->d[j] = 1.0 / (1.0 + hg * m->b[j]);
+        sum_p += m->a[j] * mem->d[j];
+        mem->phi[0][j] = m->phi[j];
+    }
+    return 1.0 / (cm->p.c_alpha * (m->eta + hg * sum_p));
+}
+
+/* Stage i's explicit part E_i, left in phi[i] until the stage's rate is
+ * known, from the rates z[0..i-1]; returns the memory's pull A_i. */
+static double esdirk_memory_pull(const contact_model *cm, double h, int i, const double *z, esdirk_memory *mem)
+{
+    const contact_modes *m = &cm->modes;
+    double Z = 0.0, A = 0.0;
+    size_t j;
+    int k;
+    for (k = 0; k < i; k++)
+        Z += esdirk_a[i][k] * z[k];
+    /* the stages' sum a_ik phi_k first, a stage at a time over the modes
+     * (contiguous: vectorised), then E_i and the pull */
+    for (j = 0; j < m->modes; j++)
+        mem->phi[i][j] = esdirk_a[i][0] * mem->phi[0][j];
+    for (k = 1; k < i; k++)
+        for (j = 0; j < m->modes; j++)
+            mem->phi[i][j] += esdirk_a[i][k] * mem->phi[k][j];
+    for (j = 0; j < m->modes; j++) {
+        const double E = mem->phi[0][j] + h * (Z - m->b[j] * mem->phi[i][j]);
+        mem->phi[i][j] = E;
+        A += m->a[j] * mem->d[j] * E;
+    }
+    return cm->p.c_alpha * A;
+}
+
+/* Stage i's modes once its rate z_i is known. */
+static void esdirk_memory_settle(const contact_model *cm, double h, int i, double z_i, esdirk_memory *mem)
+{
+    const double hgz = ESDIRK_GAMMA * h * z_i;
+    size_t j;
+    for (j = 0; j < cm->modes.modes; j++)
+        mem->phi[i][j] = mem->d[j] * (mem->phi[i][j] + hgz);
+}
+
+/* The memory force's embedded error estimate: c_alpha sum a (phi_6 - phi_5),
+ * the last stage's (the step's end) less the embedded solution's. */
+static double esdirk_memory_error(const contact_model *cm, const esdirk_memory *mem)
+{
+    const contact_modes *m = &cm->modes;
+    double change = 0.0;
+    size_t j;
+    for (j = 0; j < m->modes; j++)
+        change += m->a[j] * (mem->phi[ESDIRK_STAGES - 1][j] - mem->phi[ESDIRK_EMBEDDED][j]);
+    return cm->p.c_alpha * fabs(change);
+}
+
+/* The rates z_0..z_6 of an ESDIRK trial step from the model's state. */
+static void esdirk_trial_rates(const contact_model *cm, const contact_state *trial, double z[ESDIRK_STAGES])
+{
+    z[0] = cm->s.x2_rate;
+    z[1] = trial->x2_rate1;
+    memcpy(z + 2, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
+    z[ESDIRK_STAGES - 1] = trial->x2_rate;
+}
+
+/* What identifies an ESDIRK trial from the model's state: its start time,
+ * its length and its stage rates. */
+static void esdirk_trial_key(const contact_model *cm, const contact_state *trial, double key[ESDIRK_STAGES + 2])
+{
+    key[0] = cm->s.t;
+    key[1] = trial->step;
+    esdirk_trial_rates(cm, trial, key + 2);
+}
+
+/* Keeps the end modes of the trial just taken from the model's state. */
+static void esdirk_keep_trial(contact_model *cm, const contact_state *trial, const esdirk_memory *mem)
+{
+    esdirk_trial_key(cm, trial, cm->modes.trial_key);
+    memcpy(cm->modes.trial_end, mem->phi[ESDIRK_STAGES - 1], cm->modes.modes * sizeof cm->modes.phi[0]);
+}
+
+/* The modes after an accepted ESDIRK step from the model's state: the last
+ * stage's (stiffly accurate). Those of the last trial taken when it is the
+ * one accepted (the same rates from the same modes: the same bits), else
+ * recomputed from the trial's stage rates, so that whichever of an event
+ * search's trials is accepted brings its own. */
+void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
+{
+    esdirk_memory mem;
+    double z[ESDIRK_STAGES], key[ESDIRK_STAGES + 2];
+    int i;
+    esdirk_trial_key(cm, trial, key);
+    if (memcmp(key, cm->modes.trial_key, sizeof key) == 0) {
+        memcpy(cm->modes.phi, cm->modes.trial_end, cm->modes.modes * sizeof cm->modes.phi[0]);
+        cm->modes.trial_key[1] = 0.0;
+        return;
+    }
+    esdirk_trial_rates(cm, trial, z);
+    esdirk_memory_begin(cm, trial->step, &mem);
+    for (i = 1; i < ESDIRK_STAGES; i++) {
+        esdirk_memory_pull(cm, trial->step, i, z, &mem);
+        esdirk_memory_settle(cm, trial->step, i, z[i], &mem);
+    }
+    memcpy(cm->modes.phi, mem.phi[ESDIRK_STAGES - 1], cm->modes.modes * sizeof cm->modes.phi[0]);
+}
+
+/* One ESDIRK step of length h from *in with spring stiffness K (the
+ * contract of sdirk_step), the damper a dashpot (mem NULL) or the
+ * compressed springpot (mem its stages' scratch, its explicit stage 0 at
+ * the start's rate in->x2_rate); inlined twice below, so that the
+ * dashpot's copy carries none of the springpot's work. out->error is the
+ * embedded estimate of its error over the tolerance: x1's and x2's
+ * relative to the larger of the elastic indentation at the step's ends and
+ * at the contact's peak force so far (relative in the force at onset, where
+ * x1^n is not smooth, grading the first steps), v's relative to the speed
+ * at onset or now; a springpot's modes are state too, and their force's
+ * error counts as the travel it would drive over the step through the
+ * stage's viscosity. The springpot's E_diss is the order-5 quadrature of
+ * F x2', as the dashpot's of F^2/c (SDIRK2's mean force times the travel
+ * is of order 2 only). */
+static inline double esdirk_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
+                                    esdirk_memory *mem)
+{
+    const int last = ESDIRK_STAGES - 1;
+    damper_stage damper = {0.0, cm->inv_c};
+    double F[ESDIRK_STAGES], z[ESDIRK_STAGES], rise[ESDIRK_STAGES];
+    double X = in->x1, V = in->v, X_embedded = 0.0, V_embedded = 0.0, x2_embedded = 0.0;
+    double impulse = 0.0, work = 0.0, travel = 0.0, length, speed, error;
+    int i, j;
+    F[0] = in->F;
+    z[0] = mem ? in->x2_rate : F[0] * cm->inv_c;
+    if (mem)
+        damper.inv_B = esdirk_memory_begin(cm, h, mem);
+    for (i = 0; i <= last; i++) {
+        if (i > 0) {
+            /* each stage waits on the one before: the sums are ordered so
+             * that its rise and force come in last, at one multiply-add */
+            double xh = in->x1, vh = in->v;
+            for (j = 0; j < i; j++) {
+                xh += esdirk_a[i][j] * rise[j];
+                vh += h * esdirk_a[i][j] * cm->accel;
+                vh -= h * esdirk_a[i][j] * cm->inv_m * F[j];
+            }
+            if (mem)
+                damper.A = esdirk_memory_pull(cm, h, i, z, mem);
+            F[i] = implicit_stage(cm, K, ESDIRK_GAMMA * h, xh, vh, damper, &X, &V);
+            z[i] = (F[i] - damper.A) * damper.inv_B;
+            if (mem)
+                esdirk_memory_settle(cm, h, i, z[i], mem);
+            /* h x1' from the stage's equation X = xh + gamma h x1': a
+             * shorter chain than h (V - z) */
+            rise[i] = (X - xh) * (1.0 / ESDIRK_GAMMA);
+        } else {
+            rise[0] = h * (V - z[0]);
+        }
+        if (i == ESDIRK_EMBEDDED) {
+            X_embedded = X;
+            V_embedded = V;
+            for (j = 0; j <= i; j++)
+                x2_embedded += h * esdirk_a[i][j] * (mem ? z[j] : F[j]);
+        }
+    }
+    for (j = 0; j <= last; j++) {
+        impulse += h * esdirk_a[last][j] * F[j];
+        if (mem) {
+            travel += h * esdirk_a[last][j] * z[j];
+            work += h * esdirk_a[last][j] * F[j] * z[j];
+        } else
+            work += h * esdirk_a[last][j] * F[j] * F[j];
+    }
+    length = larger(larger(fabs(in->x1), fabs(X)), DBL_MIN);
+    if (in->F_peak_contact > larger(in->F, F[last])) /* past the peak: its indentation is the larger */
+        length = larger(length, peak_indentation(cm, K, in->F_peak_contact));
+    speed = larger(larger(fabs(in->v), fabs(V)), larger(fabs(in->v_onset), DBL_MIN));
+    *out = *in;
+    out->t = in->t + h;
+    out->x1 = X;
+    out->v = V;
+    out->F = F[last];
+    out->step = h;
+    out->x2_rate1 = z[1];
+    out->x2_rate = z[last];
+    if (mem) {
+        out->x2 = in->x2 + travel;
+        out->E_diss = in->E_diss + work;
+        memcpy(out->x2_rate_inner, z + 2, sizeof out->x2_rate_inner);
+        error = larger(larger(fabs(X - X_embedded), fabs(travel - x2_embedded)),
+                       esdirk_memory_error(cm, mem) * damper.inv_B * h) / length;
+    } else {
+        out->x2 = in->x2 + impulse * cm->inv_c;
+        out->E_diss = in->E_diss + work * cm->inv_c;
+        error = larger(fabs(X - X_embedded), fabs(impulse - x2_embedded) * cm->inv_c) / length;
+    }
+    out->error = larger(error, fabs(V - V_embedded) / speed) / cm->p.tolerance;
+    return impulse;
+}
+
+static double springpot_esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    esdirk_memory mem;
+    const double J = esdirk_step_of(cm, in, h, K, out, &mem);
+    if (in == &cm->s)
+        esdirk_keep_trial(cm, out, &mem);
+    return J;
+}
+
+/* An error-controlled step: the dashpot's, or the compressed springpot's
+ * (out of contact a recovering springpot's SDIRK2 step: esdirk_steps). */
+double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    if (!springpot(cm))
+        return esdirk_step_of(cm, in, h, K, out, NULL);
+    if (!esdirk_steps(cm, in))
+        return sdirk_step(cm, in, h, K, out);
+    return springpot_esdirk_step(cm, in, h, K, out);
+}

@@ -1,0 +1,224 @@
+/* The model's life cycle (configure, start, drive, release, copy), its
+ * outputs, and the springpot's memory as values for saving a state. */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "contact_internal.h"
+#include "soe.h"
+
+/* Gamma(5/2) = 3 sqrt(pi) / 4: x1^(3/2) = Gamma(5/2) D^(-1/2) x1 (docs/model.md §3). */
+#define GAMMA_5_2 1.329340388179137
+
+void contact_configure(contact_model *cm, const contact_params *p)
+{
+    const double n = p->spring_exponent;
+    cm->p = *p;
+    cm->k = spring_constant(p);
+    cm->n_gamma = n == 1.5 ? GAMMA_5_2 : tgamma(n + 1.0);
+    cm->inv_c = 1.0 / p->c;
+    cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
+                  : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
+    /* An error-controlled step needs its stages' roots well inside its
+     * tolerance, not to rounding. */
+    cm->error_controlled = contact_error_controlled(p);
+    cm->h_max = contact_step_limit(p);
+    resolve_contact(cm);
+    cm->series_limit = cm->error_controlled ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
+    cm->peak_force_seen = -1.0;
+    cm->peak_length = 0.0;
+    cm->modes.modes = 0;
+    cm->modes.h = 0.0;
+    cm->modes.trial_key[1] = 0.0;
+    if (compressed_memory(cm))
+        cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p),
+                                     CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, cm->modes.a, cm->modes.b,
+                                     &cm->modes.eta);
+}
+
+void contact_release(contact_model *cm)
+{
+    free(cm->history.x2);
+    free(cm->history.w);
+    memset(&cm->history, 0, sizeof cm->history);
+}
+
+void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
+{
+    memset(cm, 0, sizeof *cm);
+    contact_configure(cm, p);
+    cm->s.x1 = -p->gap0;
+    cm->s.v = v0;
+    if (p->scene == CONTACT_SCENE_DROP) {
+        cm->inv_m = 1.0 / m;
+        cm->accel = p->g;
+        resolve_contact(cm);
+    } else {
+        contact_drive(cm, v0, m, 0.0);
+    }
+}
+
+void contact_drive(contact_model *cm, double v, double m, double accel)
+{
+    if (cm->p.scene != CONTACT_SCENE_DRIVEN)
+        return;
+    if (v != cm->s.v)
+        cm->s.h_prev = 0.0; /* a multistep scheme's past no longer leads here: restart it */
+    cm->s.v = v;
+    cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;
+    cm->accel = m > 0.0 ? cm->p.g + accel : accel;
+    resolve_contact(cm);
+}
+
+double contact_damper_rate(const contact_model *cm)
+{
+    return springpot(cm) ? cm->s.x2_rate : cm->s.F * cm->inv_c;
+}
+
+void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate)
+{
+    const contact_state *s = &cm->s;
+    const double n = cm->p.spring_exponent;
+    double x1 = contact_elastic_indentation(cm);
+    *x1_rate = s->in_contact ? s->v - contact_damper_rate(cm) : 0.0;
+    *v_rate = cm->accel - cm->inv_m * s->F;
+    *F_rate = x1 > 0.0 ? n * contact_spring_stiffness(cm, s->n) * pow(x1, n - 1.0) * *x1_rate : 0.0;
+}
+
+double contact_spring_stiffness(const contact_model *cm, long n_steps)
+{
+    return spring_stiffness(cm, n_steps);
+}
+
+/* Whether the springpot holds no memory: before its first contact. */
+int memory_at_rest(const contact_model *cm)
+{
+    size_t i;
+    if (!springpot(cm))
+        return 1;
+    if (cm->s.x2 != 0.0 || cm->s.x2_rate != 0.0)
+        return 0;
+    for (i = 0; i < cm->modes.modes; i++)
+        if (cm->modes.phi[i] != 0.0)
+            return 0;
+    return 1;
+}
+
+int contact_never_returns(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    const double a = cm->accel;
+    if (s->in_contact || a > 0.0)
+        return 0;
+    /* A recovering dent (x2 falls towards 0, never below) may still meet a
+     * striker that has not cleared the undeformed surface. */
+    if (!memory_at_rest(cm) && !(s->v <= 0.0 && s->x1 + s->x2 <= 0.0))
+        return 0;
+    if (s->v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
+        return a < 0.0 && !(s->x1 + 0.5 * s->v * s->v / -a > 0.0);
+    return 1;
+}
+
+int contact_rests(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    return s->in_contact && !springpot(cm) && cm->accel == 0.0 && s->F <= DBL_EPSILON * s->F_peak_contact
+           && fabs(s->v) <= DBL_EPSILON * fabs(s->v_onset);
+}
+
+double contact_elastic_indentation(const contact_model *cm)
+{
+    return cm->s.x1 > 0.0 ? cm->s.x1 : 0.0;
+}
+
+double contact_total_indentation(const contact_model *cm)
+{
+    return cm->s.x1 + cm->s.x2;
+}
+
+double contact_semi_integral_per_force(const contact_model *cm)
+{
+    return 1.0 / (cm->n_gamma * cm->k);
+}
+
+double contact_semi_integral(const contact_model *cm)
+{
+    return cm->s.F * contact_semi_integral_per_force(cm);
+}
+
+size_t contact_memory_count(const contact_model *cm)
+{
+    if (compressed_memory(cm))
+        return 1 + cm->modes.modes;
+    return full_history(cm) ? 4 + (size_t)cm->s.steps : 0;
+}
+
+double contact_memory_get(const contact_model *cm, size_t i)
+{
+    if (i == 0)
+        return cm->s.x2_rate;
+    if (compressed_memory(cm))
+        return cm->modes.phi[i - 1];
+    if (i < 3)
+        return i == 1 ? cm->history.v_prev : cm->history.G_prev;
+    return i - 3 < cm->history.capacity ? cm->history.x2[i - 3] : 0.0; /* x2(0) = 0 before the first step */
+}
+
+int contact_memory_accepts(const contact_model *cm, size_t count, char *msg, size_t len)
+{
+    size_t expected = contact_memory_count(cm);
+    if (full_history(cm) && cm->s.steps > CONTACT_G1_HISTORY_MAX) {
+        snprintf(msg, len, "a G1 history of %lld steps exceeds the limit of %d",
+                 (long long)cm->s.steps, CONTACT_G1_HISTORY_MAX);
+        return -1;
+    }
+    if (count != expected) {
+        snprintf(msg, len, "the damper's memory holds %zu values where these parameters and %lld steps need %zu",
+                 count, (long long)cm->s.steps, expected);
+        return -1;
+    }
+    return 0;
+}
+
+int contact_memory_resize(contact_model *cm, size_t count)
+{
+    return full_history(cm) && count > 3 ? history_reserve(&cm->history, count - 3) : 0;
+}
+
+void contact_memory_set(contact_model *cm, size_t i, double value)
+{
+    if (i == 0)
+        cm->s.x2_rate = value;
+    else if (compressed_memory(cm))
+        cm->modes.phi[i - 1] = value;
+    else if (i < 3)
+        *(i == 1 ? &cm->history.v_prev : &cm->history.G_prev) = value;
+    else
+        cm->history.x2[i - 3] = value;
+}
+
+void contact_copy(contact_model *to, const contact_model *from)
+{
+    const contact_modes *f = &from->modes;
+    contact_modes *t = &to->modes;
+    const size_t bytes = f->modes * sizeof f->a[0];
+    /* all but the modes, then the modes' scalars and the used part of each array */
+    memcpy(to, from, offsetof(contact_model, modes));
+    to->history = from->history;
+    t->modes = f->modes;
+    t->eta = f->eta;
+    t->h = f->h;
+    t->sum_p = f->sum_p;
+    t->sum_q = f->sum_q;
+    t->trial_key[1] = 0.0; /* the last trial's modes are not copied */
+    memcpy(t->a, f->a, bytes);
+    memcpy(t->b, f->b, bytes);
+    memcpy(t->phi, f->phi, bytes);
+    memcpy(t->p, f->p, bytes);
+    memcpy(t->q, f->q, bytes);
+    memcpy(t->keep, f->keep, bytes);
+    memcpy(t->rate1, f->rate1, bytes);
+    memcpy(t->rate2, f->rate2, bytes);
+}

@@ -1,0 +1,113 @@
+/* Whether fixed steps resolve an impact: the time a striker takes to stop,
+ * the uniform grids' check of dt_max against it, the warning where SDIRK2's
+ * fixed steps are refined in contact, and the fixed step of a contact. */
+#include <math.h>
+#include <stdio.h>
+
+#include "contact_internal.h"
+
+/* The time the spring K x1^n takes to stop a striker (1/inv_m its mass)
+ * arriving at speed v, x_max / v with x_max = ((n + 1) v^2 / (2 K inv_m))^(1/(n+1))
+ * the elastic impact's largest indentation (docs/model.md §2), or where a load
+ * a > 0 presses the striker in, sqrt(x_a / a) with x_a = (a / (K inv_m))^(1/n)
+ * its indentation at rest under it: the shorter. A step much longer sees the
+ * striker stopped and thrown back within it, and the stages of a step that
+ * holds a whole impact give back more than it brought (eps = sqrt(2) as the
+ * mass vanishes). INFINITY without inertia (inv_m = 0) or either. */
+static double turnaround_time(double n, double K, double inv_m, double v, double a)
+{
+    double t = INFINITY;
+    if (!(inv_m > 0.0))
+        return t;
+    /* Power by power, so that no product of the inputs under- or overflows
+     * (v^2 of a denormal v is 0, which made the step 0). */
+    if (v > 0.0)
+        t = pow((n + 1.0) / (2.0 * K), 1.0 / (n + 1.0)) * pow(inv_m, -1.0 / (n + 1.0)) * pow(v, (1.0 - n) / (n + 1.0));
+    if (a > 0.0)
+        t = fmin(t, sqrt(pow(a, 1.0 / n - 1.0) * pow(K, -1.0 / n) * pow(inv_m, -1.0 / n)));
+    return t;
+}
+
+/* The time the damper alone takes to stop the striker: m / c for the
+ * dashpot, (m / c_alpha)^(1/(2 - alpha)) for the springpot (the time scale
+ * of m x'' = -c_alpha D^alpha x). */
+static double damper_time(const contact_params *p, double inv_m)
+{
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT)
+        return pow(p->c_alpha * inv_m, -1.0 / (2.0 - p->damper_order));
+    return 1.0 / (p->c * inv_m);
+}
+
+/* The turnaround time (above), or the damper's time where that is longer:
+ * while the striker loads the specimen, the series damper bounds the force
+ * (below c v for the dashpot), so no striker stops faster (a rigid spring
+ * leaves the damper alone). */
+static double stopping_time(const contact_params *p, double K, double inv_m, double v, double a)
+{
+    return fmax(turnaround_time(p->spring_exponent, K, inv_m, v, a), damper_time(p, inv_m));
+}
+
+/* The stopping time (above) of the first impact of a striker of mass m
+ * starting at v: the fastest, since the striker arrives at v (or falls
+ * through the gap under g) and every impact after loses speed. */
+static double first_turnaround(const contact_params *p, double v, double m)
+{
+    const double v2 = v > 0.0 || p->g > 0.0 ? v * v + 2.0 * p->g * p->gap0 : 0.0;
+    if (!(m > 0.0))
+        return INFINITY;
+    return stopping_time(p, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
+}
+
+/* "dt_max = 0 (fixed steps of 1e-07 s)" or "dt_max = 2e-07": the step as given. */
+static const char *shown_step(const contact_params *p, char text[64])
+{
+    char value[32];
+    if (p->dt_max > 0.0)
+        snprintf(text, 64, "dt_max = %s", shown(p->dt_max, value));
+    else
+        snprintf(text, 64, "dt_max = 0 (fixed steps of %s s)", shown(CONTACT_DEFAULT_STEP, value));
+    return text;
+}
+
+int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len)
+{
+    const double t = first_turnaround(p, v, m);
+    char text[3][64];
+    if (!uniform_grid(p) || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+        return 0;
+    snprintf(msg, len,
+             "%s is invalid with m = %s, v = %s: the spring stops the striker in %.3g s, which the %s uniform grid "
+             "resolves only in steps of at most %.3g s (%d per stop); lower dt_max to that, or take scheme = 1 and "
+             "memory = 2, whose steps shorten in contact",
+             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t,
+             contact_method(p) == CONTACT_METHOD_CENTRAL ? "central scheme's" : "full G1 history's", t / CONTACT_RESOLUTION,
+             CONTACT_RESOLUTION);
+    return -1;
+}
+
+int contact_step_warning(const contact_params *p, double v, double m, char *msg, size_t len)
+{
+    const double t = first_turnaround(p, v, m);
+    char text[3][64];
+    if (contact_method(p) != CONTACT_METHOD_SDIRK2 || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+        return 0;
+    snprintf(msg, len,
+             "%s does not resolve the impact of m = %s at v = %s: the spring stops the striker in %.3g s, less "
+             "than %d steps; in contact the fixed steps are %.3g s instead (%d per stop)",
+             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t, CONTACT_RESOLUTION,
+             t / CONTACT_REFINED, CONTACT_REFINED);
+    return 1;
+}
+
+/* The fixed step in the current contact: dt_max where it resolves the
+ * impact (CONTACT_RESOLUTION steps in its turnaround time) or the grid is
+ * uniform, else CONTACT_REFINED steps in that time: a step that does not
+ * resolve it is no one's choice, and a barely resolved one would show
+ * SDIRK2's gain of energy in nearly elastic impacts, which grows with the
+ * step like (h/t_c)^2.5 (docs/stability.md). Set where the onset speed or
+ * the inertia change. */
+void resolve_contact(contact_model *cm)
+{
+    const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
+    cm->contact_step = uniform_grid(&cm->p) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
+}
