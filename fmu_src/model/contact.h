@@ -157,11 +157,6 @@ typedef struct {
     double sum_p, sum_q;          /* sum_i p_i, sum_i q_i */
     double p[CONTACT_MAX_MODES], q[CONTACT_MAX_MODES];      /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
     double keep[CONTACT_MAX_MODES], rate1[CONTACT_MAX_MODES], rate2[CONTACT_MAX_MODES]; /* the update */
-    /* The modes at the end of the last error-controlled trial step and
-     * what identifies it: its start time, its length (0: none) and its
-     * seven stage rates x2', so that accepting it copies them. */
-    double trial_key[9];
-    double trial_end[CONTACT_MAX_MODES];
 } contact_modes; /* a new field: copy it in contact_copy too */
 
 /* The full G1 history (a springpot with memory = 1): x2 at every step since

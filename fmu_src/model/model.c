@@ -31,7 +31,6 @@ void contact_configure(contact_model *cm, const contact_params *p)
     cm->peak_length = 0.0;
     cm->modes.modes = 0;
     cm->modes.h = 0.0;
-    cm->modes.trial_key[1] = 0.0;
     if (compressed_memory(cm))
         cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p),
                                      CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, cm->modes.a, cm->modes.b,
@@ -212,7 +211,6 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->h = f->h;
     t->sum_p = f->sum_p;
     t->sum_q = f->sum_q;
-    t->trial_key[1] = 0.0; /* the last trial's modes are not copied */
     memcpy(t->a, f->a, bytes);
     memcpy(t->b, f->b, bytes);
     memcpy(t->phi, f->phi, bytes);
