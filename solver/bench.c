@@ -18,6 +18,12 @@
  *                                     1e3, 1e4, ... LARGEST_N (default 1e6)
  *                                     steps of one span: CPU, F_peak, eps, the
  *                                     memory's values and the history's heap
+ *   fraccontact-bench controlled TOLERANCE
+ *                                     the error-controlled h20 impact (law 2)
+ *                                     of the dashpot and of the springpot's
+ *                                     compressed memory side by side: CPU per
+ *                                     impact (batches alternated, medians),
+ *                                     steps and the impact's figures
  *   fraccontact-bench anchor K C M V T_END RTOL [REPEATS]
  *                                     the speed anchor of issue 14 (anchor.h):
  *                                     one impact by GSL's rk8pd as a user would
@@ -351,6 +357,54 @@ static int bench_springpot(double largest)
     return 0;
 }
 
+/* ------------------------------------------------ error-controlled h20 */
+
+/* Batches of this many impacts, alternated between the two dampers for
+ * this many rounds: a batch takes a few ms, so that a burst of other work
+ * slows both alike. */
+#define CONTROLLED_BATCH 50
+#define CONTROLLED_ROUNDS 41
+
+static void controlled_params(fc_params *p, int damper, double tolerance)
+{
+    fc_params_default(p);
+    p->law = CONTACT_LAW_HERTZ;
+    p->tolerance = tolerance;
+    p->damper = damper;
+}
+
+static void print_controlled(const char *name, const fc_outcome *o, double seconds)
+{
+    printf("\"%s\": {\"seconds_per_impact\": %.6g, \"steps\": %lld, \"F_peak\": %.17g, \"eps\": %.17g, "
+           "\"t_contact\": %.17g, \"x2_end\": %.17g, \"E_diss\": %.17g}",
+           name, seconds, (long long)o->steps, o->first.F_peak, o->first.eps, o->first.t_contact, o->first.x2_end,
+           o->first.E_diss);
+}
+
+static int bench_controlled(double tolerance)
+{
+    fc_params p[2][CONTROLLED_BATCH];
+    fc_outcome out[2][CONTROLLED_BATCH];
+    double runs[2][CONTROLLED_ROUNDS];
+    int r, d, i;
+    for (d = 0; d < 2; d++)
+        for (i = 0; i < CONTROLLED_BATCH; i++)
+            controlled_params(&p[d][i], d == 0 ? CONTACT_DAMPER_DASHPOT : CONTACT_DAMPER_SPRINGPOT, tolerance);
+    for (r = 0; r < CONTROLLED_ROUNDS; r++)
+        for (d = 0; d < 2; d++) {
+            double t0 = cpu_seconds();
+            if (fc_run_batch(CONTROLLED_BATCH, p[d], out[d]) != FC_OK)
+                return 1;
+            runs[d][r] = (cpu_seconds() - t0) / CONTROLLED_BATCH;
+        }
+    printf("{\"tolerance\": %g, \"batch\": %d, \"rounds\": %d, ", tolerance, CONTROLLED_BATCH, CONTROLLED_ROUNDS);
+    print_controlled("dashpot", &out[0][0], median(runs[0], CONTROLLED_ROUNDS));
+    printf(", ");
+    print_controlled("springpot", &out[1][0], median(runs[1], CONTROLLED_ROUNDS));
+    printf("}\n");
+    return 0;
+}
+
 /* ------------------------------------------------------------ anchor */
 
 /* A figure, or null when the run did not get there. */
@@ -435,9 +489,11 @@ int main(int argc, char **argv)
         return bench_g1((size_t)atol(argv[2]), atof(argv[3]));
     if ((argc == 2 || (argc == 3 && atof(argv[2]) >= 1e3)) && strcmp(argv[1], "springpot") == 0)
         return bench_springpot(argc == 3 ? atof(argv[2]) : 1e6);
+    if (argc == 3 && strcmp(argv[1], "controlled") == 0 && atof(argv[2]) > 0.0)
+        return bench_controlled(atof(argv[2]));
     if ((argc == 8 || argc == 9) && strcmp(argv[1], "anchor") == 0)
         return anchor_arguments(argv + 2, &anchor) != 0 ? 2 : bench_anchor(&anchor, argc == 9 ? atoi(argv[8]) : 0);
     fprintf(stderr, "usage: fraccontact-bench step | g1 N ALPHA | batch N LAW DT_MAX | springpot [LARGEST_N] | "
-                    "anchor K C M V T_END RTOL [REPEATS]\n");
+                    "controlled TOLERANCE | anchor K C M V T_END RTOL [REPEATS]\n");
     return 2;
 }

@@ -7,6 +7,7 @@
 
 #include "check.h"
 #include "contact.h"
+#include "contact_internal.h"
 
 static const double V0 = 0.626418, M = 0.7437; /* the paper's h20 drop */
 
@@ -293,6 +294,34 @@ static void test_step_limit(void)
           "within the limit it goes through: %lld steps", (long long)cm.s.steps);
 }
 
+/* The springpot's first error-controlled step of a contact is accepted at
+ * its first trial (a rejection wastes a trial of 67 modes): its length from
+ * the springpot's own time scale, not the dashpot's c. */
+static void test_springpot_onset_step(void)
+{
+    static const double alphas[] = {0.2, 0.5, 0.8}, tolerances[] = {1e-6, 1e-8, 1e-10};
+    size_t i, j;
+    for (i = 0; i < sizeof alphas / sizeof alphas[0]; i++)
+        for (j = 0; j < sizeof tolerances / sizeof tolerances[0]; j++) {
+            contact_params p;
+            contact_model cm;
+            contact_state trial;
+            double v0, m, h;
+            contact_default_params(&p);
+            contact_default_striker(&v0, &m);
+            p.law = CONTACT_LAW_HERTZ;
+            p.damper = CONTACT_DAMPER_SPRINGPOT;
+            p.damper_order = alphas[i];
+            p.tolerance = tolerances[j];
+            contact_start(&cm, &p, v0, m);
+            contact_advance_until(&cm, 1.0, CONTACT_ONSET);
+            h = onset_step(&cm);
+            esdirk_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
+            CHECK(cm.s.in_contact && trial.error <= 1.0, "alpha %g, tolerance %g: the onset step %.3g errs %.3g",
+                  alphas[i], tolerances[j], h, trial.error);
+        }
+}
+
 int main(void)
 {
     test_hertz_constant();
@@ -304,6 +333,7 @@ int main(void)
     test_stability();
     test_gap_and_gravity();
     test_step_limit();
+    test_springpot_onset_step();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

@@ -67,6 +67,21 @@ static double unscaled_step(const contact_model *cm)
     return isfinite(cm->h_max) ? cm->h_max : CONTACT_DEFAULT_STEP;
 }
 
+/* The springpot's first step: where the dent, c_alpha D^alpha x2 = K (v t)^n,
+ *     x2 = K v^n Gamma(n + 1) / Gamma(n + 1 + alpha) t^(n + alpha) / c_alpha,
+ * has moved SPRINGPOT_ONSET_MOVEMENT tolerances relative to v h: the
+ * dashpot's c says nothing of its time scale. Its x2 is less smooth there
+ * than the dashpot's (t^(n + alpha)), the embedded error a larger part of
+ * the movement, hence the smaller movement; 0 where the power underflows. */
+#define SPRINGPOT_ONSET_MOVEMENT 30.0
+
+static double springpot_onset_step(const contact_model *cm, double Kv)
+{
+    const double n = cm->p.spring_exponent, alpha = cm->p.damper_order;
+    const double scale = tgamma(n + 1.0 + alpha) / tgamma(n + 1.0);
+    return pow(SPRINGPOT_ONSET_MOVEMENT * cm->p.tolerance * cm->p.c_alpha * scale / Kv, 1.0 / (n + alpha - 1.0));
+}
+
 double onset_step(const contact_model *cm)
 {
     const double n = cm->p.spring_exponent, v = cm->s.v, tol = ONSET_MOVEMENT * cm->p.tolerance;
@@ -74,7 +89,8 @@ double onset_step(const contact_model *cm)
     if (!(v > 0.0))
         return unscaled_step(cm);
     Kv = contact_spring_stiffness(cm, 1) * pow(v, n - 1.0);
-    h = fmin(cm->h_max, pow(tol * cm->p.c / Kv, 1.0 / n));
+    h = springpot(cm) ? springpot_onset_step(cm, Kv) : 0.0;
+    h = fmin(cm->h_max, h > 0.0 ? h : pow(tol * cm->p.c / Kv, 1.0 / n));
     if (cm->inv_m > 0.0)
         h = fmin(h, pow(tol / (cm->inv_m * Kv), 1.0 / (n + 1.0)));
     return h;

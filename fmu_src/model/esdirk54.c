@@ -49,68 +49,89 @@ static double peak_indentation(contact_model *cm, double K, double F_peak)
  * so its force c_alpha (eta z_i + sum a phi_i) is A_i + z_i / inv_B: the
  * memory's pull A_i = c_alpha sum a d E_i and the viscosity
  * 1/inv_B = c_alpha (eta + gamma h sum a d), one scalar root per stage
- * still. Stage 0 is the step's start. The stages' modes are kept for the
- * stages that follow: on the stack (10 kB), no allocation. */
+ * still. Stage 0 is the step's start. */
+/* A trial step needs the modes only through the force's sums c sum a phi,
+ * and each stage's modes are linear in the start's and in the rates: with
+ * u = gamma h b d = 1 - d, stage i's modes are
+ *     phi_i = d phi_n - (u / gamma) sum_{k<i} a_ik phi_k + d h (Z_i + gamma z_i),
+ *     Z_i = sum_{k<i} a_ik z_k   (phi_0 = phi_n),
+ * polynomials of degree i in u. Their sums mu_i[m] = sum a u^m phi_i then
+ * follow from the sums of the start's modes by the same recursion, one
+ * degree down a stage:
+ *     mu_i[m] = D[m] - (1/gamma) sum_{k<i} a_ik mu_k[m + 1] + h (Z_i + gamma z_i) W[m],
+ *     D[m] = sum a d u^m phi_n,  W[m] = sum a d u^m,  mu_0[m] = S[m] = sum a u^m phi_n,
+ * and stage i's pull A_i is c_alpha times mu_i[0] without its z_i term: one
+ * pass over the modes a trial (esdirk_moments_begin), the stages scalar. */
+#define ESDIRK_DEGREES (ESDIRK_STAGES - 1)
 typedef struct {
-    double d[CONTACT_MAX_MODES];
-    double phi[ESDIRK_STAGES][CONTACT_MAX_MODES];
-} esdirk_memory;
+    double S[ESDIRK_STAGES], D[ESDIRK_DEGREES], W[ESDIRK_DEGREES];
+    double mu[ESDIRK_STAGES][ESDIRK_STAGES]; /* mu_i[m] for m <= 6 - i, all the later stages need */
+} esdirk_moments;
 
-/* The step's d and the stage 0 modes; returns inv_B. */
-static double esdirk_memory_begin(const contact_model *cm, double h, esdirk_memory *mem)
+/* The start's sums S, D, W for a step of length h; returns inv_B. The
+ * sums in local variables: the compiler keeps them in registers. */
+static double esdirk_moments_begin(const contact_model *cm, double h, esdirk_moments *mom)
 {
     const contact_modes *m = &cm->modes;
     const double hg = ESDIRK_GAMMA * h;
-    double sum_p = 0.0;
+    double S[ESDIRK_STAGES] = {0.0}, D[ESDIRK_DEGREES] = {0.0}, W[ESDIRK_DEGREES] = {0.0};
     size_t j;
+    int k;
     for (j = 0; j < m->modes; j++) {
-        mem->d[j] = 1.0 / (1.0 + hg * m->b[j]);
-        sum_p += m->a[j] * mem->d[j];
-        mem->phi[0][j] = m->phi[j];
+        const double d = 1.0 / (1.0 + hg * m->b[j]), u = hg * m->b[j] * d;
+        double x = m->a[j] * m->phi[j], y = m->a[j] * d;
+        for (k = 0; k < ESDIRK_DEGREES; k++) {
+            D[k] += d * x;
+            W[k] += y;
+            x *= u;
+            y *= u;
+            S[k + 1] += x;
+        }
     }
-    return 1.0 / (cm->p.c_alpha * (m->eta + hg * sum_p));
+    memcpy(mom->S, S, sizeof S);
+    memcpy(mom->D, D, sizeof D);
+    memcpy(mom->W, W, sizeof W);
+    for (k = 1; k < ESDIRK_STAGES; k++)
+        mom->mu[0][k] = S[k];
+    return 1.0 / (cm->p.c_alpha * (m->eta + hg * W[0]));
 }
 
-/* Stage i's explicit part E_i, left in phi[i] until the stage's rate is
- * known, from the rates z[0..i-1]; returns the memory's pull A_i. */
-static double esdirk_memory_pull(const contact_model *cm, double h, int i, const double *z, esdirk_memory *mem)
+/* sum_{k<i} a_ik mu_k[m] */
+static double esdirk_moments_past(int i, int m, const esdirk_moments *mom)
 {
-    const contact_modes *m = &cm->modes;
-    double Z = 0.0, A = 0.0;
-    size_t j;
+    double past = 0.0;
+    int k;
+    for (k = 0; k < i; k++)
+        past += esdirk_a[i][k] * mom->mu[k][m];
+    return past;
+}
+
+/* Stage i's pull A_i from the rates z[0..i-1]. */
+static double esdirk_moments_pull(const contact_model *cm, double h, int i, const double *z, const esdirk_moments *mom)
+{
+    double Z = 0.0;
     int k;
     for (k = 0; k < i; k++)
         Z += esdirk_a[i][k] * z[k];
-    for (j = 0; j < m->modes; j++) {
-        double past = 0.0, E;
-        for (k = 0; k < i; k++)
-            past += esdirk_a[i][k] * mem->phi[k][j];
-        E = mem->phi[0][j] + h * (Z - m->b[j] * past);
-        mem->phi[i][j] = E;
-        A += m->a[j] * mem->d[j] * E;
-    }
-    return cm->p.c_alpha * A;
+    return cm->p.c_alpha * (mom->D[0] - esdirk_moments_past(i, 1, mom) * (1.0 / ESDIRK_GAMMA) + h * Z * mom->W[0]);
 }
 
-/* Stage i's modes once its rate z_i is known. */
-static void esdirk_memory_settle(const contact_model *cm, double h, int i, double z_i, esdirk_memory *mem)
+/* Stage i's sums once its rate z[i] is known. */
+static void esdirk_moments_settle(double h, int i, const double *z, esdirk_moments *mom)
 {
-    const double hgz = ESDIRK_GAMMA * h * z_i;
-    size_t j;
-    for (j = 0; j < cm->modes.modes; j++)
-        mem->phi[i][j] = mem->d[j] * (mem->phi[i][j] + hgz);
+    double Z = ESDIRK_GAMMA * z[i];
+    int k, m;
+    for (k = 0; k < i; k++)
+        Z += esdirk_a[i][k] * z[k];
+    for (m = 0; m + i < ESDIRK_STAGES; m++)
+        mom->mu[i][m] = mom->D[m] - esdirk_moments_past(i, m + 1, mom) * (1.0 / ESDIRK_GAMMA) + h * Z * mom->W[m];
 }
 
 /* The memory force's embedded error estimate: c_alpha sum a (phi_6 - phi_5),
  * the last stage's (the step's end) less the embedded solution's. */
-static double esdirk_memory_error(const contact_model *cm, const esdirk_memory *mem)
+static double esdirk_moments_error(const contact_model *cm, const esdirk_moments *mom)
 {
-    const contact_modes *m = &cm->modes;
-    double change = 0.0;
-    size_t j;
-    for (j = 0; j < m->modes; j++)
-        change += m->a[j] * (mem->phi[ESDIRK_STAGES - 1][j] - mem->phi[ESDIRK_EMBEDDED][j]);
-    return cm->p.c_alpha * fabs(change);
+    return cm->p.c_alpha * fabs(mom->mu[ESDIRK_STAGES - 1][0] - mom->mu[ESDIRK_EMBEDDED][0]);
 }
 
 /* The rates z_0..z_6 of an ESDIRK trial step from the model's state. */
@@ -123,20 +144,42 @@ static void esdirk_trial_rates(const contact_model *cm, const contact_state *tri
 }
 
 /* The modes after an accepted ESDIRK step from the model's state: the last
- * stage's (stiffly accurate), recomputed from the trial's stage rates, so
- * that whichever of an event search's trials is accepted brings its own. */
+ * stage's (stiffly accurate), so that whichever of an event search's trials
+ * is accepted brings its own. By the recursion of esdirk_moments each
+ * stage's modes are a polynomial in u, phi_i = sum_m u^m (P_i[m] phi_n + w_i[m]),
+ * its coefficients from the tableau (P) and the trial's rates (w):
+ *     P_i[m] = [m = 0] - [m = 1] - (1/gamma) sum_{k<i} a_ik P_k[m - 1],
+ *     w_i[m] = h (Z_i + gamma z_i) ([m = 0] - [m = 1]) - (1/gamma) sum_{k<i} a_ik w_k[m - 1],
+ * so that a mode's end is one Horner evaluation. */
 void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
 {
-    esdirk_memory mem;
-    double z[ESDIRK_STAGES];
-    int i;
+    contact_modes *m = &cm->modes;
+    const double h = trial->step, hg = ESDIRK_GAMMA * h;
+    double P[ESDIRK_STAGES][ESDIRK_STAGES] = {{1.0}}, w[ESDIRK_STAGES][ESDIRK_STAGES] = {{0.0}}, z[ESDIRK_STAGES];
+    size_t j;
+    int i, k, n;
     esdirk_trial_rates(cm, trial, z);
-    esdirk_memory_begin(cm, trial->step, &mem);
     for (i = 1; i < ESDIRK_STAGES; i++) {
-        esdirk_memory_pull(cm, trial->step, i, z, &mem);
-        esdirk_memory_settle(cm, trial->step, i, z[i], &mem);
+        double Z = ESDIRK_GAMMA * z[i];
+        for (k = 0; k < i; k++)
+            Z += esdirk_a[i][k] * z[k];
+        P[i][0] = 1.0;
+        P[i][1] = -1.0;
+        w[i][0] = h * Z;
+        w[i][1] = -h * Z;
+        for (n = 1; n <= i; n++)
+            for (k = 0; k < i; k++) {
+                P[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * P[k][n - 1];
+                w[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * w[k][n - 1];
+            }
     }
-    memcpy(cm->modes.phi, mem.phi[ESDIRK_STAGES - 1], cm->modes.modes * sizeof cm->modes.phi[0]);
+    for (j = 0; j < m->modes; j++) {
+        const double u = hg * m->b[j] / (1.0 + hg * m->b[j]), phi = m->phi[j];
+        double end = P[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1] * phi + w[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1];
+        for (n = ESDIRK_STAGES - 2; n >= 0; n--)
+            end = end * u + (P[ESDIRK_STAGES - 1][n] * phi + w[ESDIRK_STAGES - 1][n]);
+        m->phi[j] = end;
+    }
 }
 
 /* One ESDIRK step of length h from *in with spring stiffness K (the
@@ -154,7 +197,7 @@ void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
  * F x2', as the dashpot's of F^2/c (SDIRK2's mean force times the travel
  * is of order 2 only). */
 static inline double esdirk_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
-                                    esdirk_memory *mem)
+                                    esdirk_moments *mem)
 {
     const int last = ESDIRK_STAGES - 1;
     damper_stage damper = {0.0, cm->inv_c};
@@ -165,7 +208,7 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
     F[0] = in->F;
     z[0] = mem ? in->x2_rate : F[0] * cm->inv_c;
     if (mem)
-        damper.inv_B = esdirk_memory_begin(cm, h, mem);
+        damper.inv_B = esdirk_moments_begin(cm, h, mem);
     for (i = 0; i <= last; i++) {
         if (i > 0) {
             /* each stage waits on the one before: the sums are ordered so
@@ -177,11 +220,11 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
                 vh -= h * esdirk_a[i][j] * cm->inv_m * F[j];
             }
             if (mem)
-                damper.A = esdirk_memory_pull(cm, h, i, z, mem);
+                damper.A = esdirk_moments_pull(cm, h, i, z, mem);
             F[i] = implicit_stage(cm, K, ESDIRK_GAMMA * h, xh, vh, damper, &X, &V);
             z[i] = (F[i] - damper.A) * damper.inv_B;
             if (mem)
-                esdirk_memory_settle(cm, h, i, z[i], mem);
+                esdirk_moments_settle(h, i, z, mem);
             /* h x1' from the stage's equation X = xh + gamma h x1': a
              * shorter chain than h (V - z) */
             rise[i] = (X - xh) * (1.0 / ESDIRK_GAMMA);
@@ -220,7 +263,7 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
         out->E_diss = in->E_diss + work;
         memcpy(out->x2_rate_inner, z + 2, sizeof out->x2_rate_inner);
         error = larger(larger(fabs(X - X_embedded), fabs(travel - x2_embedded)),
-                       esdirk_memory_error(cm, mem) * damper.inv_B * h) / length;
+                       esdirk_moments_error(cm, mem) * damper.inv_B * h) / length;
     } else {
         out->x2 = in->x2 + impulse * cm->inv_c;
         out->E_diss = in->E_diss + work * cm->inv_c;
@@ -232,7 +275,7 @@ static inline double esdirk_step_of(contact_model *cm, const contact_state *in, 
 
 static double springpot_esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    esdirk_memory mem;
+    esdirk_moments mem;
     return esdirk_step_of(cm, in, h, K, out, &mem);
 }
 

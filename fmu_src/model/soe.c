@@ -17,50 +17,72 @@
  * fast rates cut at u_max, where e^(-e^u delta) has fallen below it; and the
  * slow rates lumped into one spring, whose e^(-b tau) ~ 1 holds while
  * (e^u_min span)^(1 + alpha) stays below it. The first two are solved by
- * bisection, the third in closed form. */
+ * Newton's method, the third in closed form: a kernel is built for every
+ * model configured (and checked), so a few evaluations, not a bisection's
+ * hundred. */
 
-/* ln |Gamma(alpha + i y)| by Stirling's series to its 1/(12 z) term, which
- * at |z| >= 1 errs by less than 1/(360 |z|^3): ample for a bound. */
-static double log_gamma_modulus(double alpha, double y)
-{
-    const double r2 = alpha * alpha + y * y;
-    return (alpha - 0.5) * 0.5 * log(r2) - y * atan2(y, alpha) - alpha + 0.5 * log(2.0 * PI) + alpha / (12.0 * r2);
-}
+/* ln f and its slope d ln f / d ln x of a bound f decreasing in x. */
+typedef void (*log_bound)(double alpha, double lg_alpha, double x, double *value, double *slope);
 
-/* The smallest x in [lo, hi] with f(x) <= target for a decreasing f, by
- * bisection on ln x: lo if f(lo) is already below. */
-static double decreasing_below(double (*f)(double, double), double alpha, double target, double lo, double hi)
+/* The trapezoidal rule's relative error at aliasing frequency y = 2 pi/du,
+ * 2 |Gamma(alpha + i y)| / Gamma(alpha), with ln |Gamma(alpha + i y)| by
+ * Stirling's series to its 1/(12 z) term, which at |z| >= 1 errs by less
+ * than 1/(360 |z|^3): ample for a bound. */
+static void aliasing_error(double alpha, double lg_alpha, double y, double *value, double *slope)
 {
-    int i;
-    if (f(alpha, lo) <= target)
-        return lo;
-    for (i = 0; i < 100; i++) {
-        double mid = sqrt(lo * hi);
-        if (f(alpha, mid) <= target)
-            hi = mid;
-        else
-            lo = mid;
-    }
-    return hi;
-}
-
-/* The trapezoidal rule's relative error at aliasing frequency y = 2 pi/du. */
-static double aliasing_error(double alpha, double y)
-{
-    return 2.0 * exp(log_gamma_modulus(alpha, y) - lgamma(alpha));
+    const double r2 = alpha * alpha + y * y, angle = atan2(y, alpha);
+    *value = log(2.0) + (alpha - 0.5) * 0.5 * log(r2) - y * angle - alpha + 0.5 * log(2.0 * PI) + alpha / (12.0 * r2)
+             - lg_alpha;
+    *slope = y * (-0.5 * y / r2 - angle - alpha * y / (6.0 * r2 * r2));
 }
 
 /* The kernel's fraction carried by rates above x / delta at tau = delta. */
-static double fast_tail(double alpha, double x)
+static void fast_tail(double alpha, double lg_alpha, double x, double *value, double *slope)
 {
-    return exp((alpha - 1.0) * log(x) - x - lgamma(alpha));
+    *value = (alpha - 1.0) * log(x) - x - lg_alpha;
+    *slope = (alpha - 1.0) - x;
+}
+
+/* The smallest x in [lo, hi] with f(x) <= target for a decreasing f: lo if
+ * f(lo) is already below, hi if f(hi) is not. Newton's method in ln x,
+ * kept inside the bracket (a step leaving it bisects it), to rounding. */
+static double decreasing_below(log_bound f, double alpha, double target, double lo, double hi)
+{
+    const double lg_alpha = lgamma(alpha), goal = log(target);
+    double a = log(lo), b = log(hi), s, value, slope;
+    int i;
+    f(alpha, lg_alpha, lo, &value, &slope);
+    if (value <= goal)
+        return lo;
+    f(alpha, lg_alpha, hi, &value, &slope);
+    if (value > goal)
+        return hi;
+    s = b;
+    for (i = 0; i < 100; i++) {
+        double next = s - (value - goal) / slope;
+        /* quadratic convergence: after a step of 1e-13 the iterate is
+         * exact to rounding (an absolute step in ln x, which is >= 0) */
+        if (fabs(next - s) <= 1e-13)
+            return exp(next);
+        if (b - a <= 1e-13)
+            return exp(b);
+        if (!(next > a && next < b))
+            next = 0.5 * (a + b);
+        s = next;
+        f(alpha, lg_alpha, exp(s), &value, &slope);
+        if (value <= goal)
+            b = s;
+        else
+            a = s;
+    }
+    return exp(b);
 }
 
 size_t soe_kernel(double alpha, double tolerance, double delta, double span, size_t max, double *a, double *b,
                   double *eta)
 {
     const double part = tolerance / 4.0;
-    double du, weight, u_max, u_min, u, ratio;
+    double du, weight, u_max, u_min, u, ratio, step_a, step_b;
     size_t n = 0;
     if (alpha >= 1.0) { /* the dashpot: a delta function */
         *eta = 1.0;
@@ -76,11 +98,15 @@ size_t soe_kernel(double alpha, double tolerance, double delta, double span, siz
     /* The lumped dashpot: the rule's terms above u_max, sum_j a_j / b_j. */
     ratio = exp((alpha - 1.0) * du);
     *eta = weight * exp((alpha - 1.0) * u_max) * ratio / (1.0 - ratio);
+    /* the terms' geometric progressions by products: within rounding of
+     * the exponentials over the largest number of terms */
+    step_a = exp(-alpha * du);
+    step_b = exp(-du);
     for (u = u_max; u > u_min; u -= du) {
         if (n == max)
             return max + 1;
-        a[n] = weight * exp(alpha * u);
-        b[n] = exp(u);
+        a[n] = n == 0 ? weight * exp(alpha * u) : a[n - 1] * step_a;
+        b[n] = n == 0 ? exp(u) : b[n - 1] * step_b;
         n++;
     }
     /* The lumped spring: the rule's terms below the slowest one kept. */

@@ -63,6 +63,10 @@ REPEATS = 3
 FIT_ROWS = 1000
 BEGIN, END = "<!-- package: begin -->", "<!-- package: end -->"
 SPRINGPOT_BEGIN, SPRINGPOT_END = "<!-- springpot: begin -->", "<!-- springpot: end -->"
+CONTROLLED_BEGIN, CONTROLLED_END = "<!-- controlled springpot: begin -->", "<!-- controlled springpot: end -->"
+CONTROLLED_TOLERANCES = (1e-6, 1e-8)
+CONTROLLED_REFERENCE = 1e-11  # the figures' reference: the same impact at this tolerance
+CONTROLLED_FIGURES = ("F_peak", "eps", "t_contact", "x2_end", "E_diss")
 # Section 5: the commit before the springpot, whose dashpot this build's must
 # match; rounds alternating its fraccontact-bench and this build's.
 BASE = "65bf8cb"
@@ -1043,7 +1047,41 @@ def seconds(x):
 
 # --- the report ---------------------------------------------------------------
 
-def write(path, steps, precision, g1, alpha, package, springpot):
+# --- 6. the springpot under error control (issue 26) ---------------------------
+
+def controlled_rows(bench):
+    """fraccontact-bench controlled at each tolerance (the dashpot and the
+    springpot side by side), and each damper's figures at the reference
+    tolerance from the library."""
+    rows = [run(bench, "controlled", f"{tol:g}") for tol in CONTROLLED_TOLERANCES]
+    reference = {name: model.impacts(law=2, damper=damper, tolerance=CONTROLLED_REFERENCE)
+                 for name, damper in (("dashpot", 1), ("springpot", 2))}
+    return rows, reference
+
+
+def controlled_section(rows, reference):
+    out = [CONTROLLED_BEGIN, "## The springpot under error control", "",
+           "Regenerate this section alone, in place: `scripts/report benchmarks --only controlled` (about a "
+           "minute). The h20 impact (law 2, error-controlled ESDIRK 5(4) steps) of the dashpot (`damper` 1) and of "
+           "the springpot (`damper` 2, alpha 0.5, c_alpha 3e5, compressed memory), CPU per impact of "
+           "`fc_run_batch` batches alternated between the two, medians (`fraccontact-bench controlled TOLERANCE`). "
+           f"Errors: the largest relative error of {', '.join(CONTROLLED_FIGURES)} against the same damper's "
+           f"impact at tolerance {CONTROLLED_REFERENCE:g}.", "",
+           "| tolerance | dashpot: us per impact | steps | largest error | springpot: us per impact | steps | "
+           "largest error | springpot / dashpot |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        cells = [f"{r['tolerance']:g}"]
+        for name in ("dashpot", "springpot"):
+            x, ref = r[name], reference[name]
+            error = max(abs(x[f] - float(getattr(ref, f))) / abs(float(getattr(ref, f))) for f in CONTROLLED_FIGURES)
+            cells += [f"{x['seconds_per_impact'] * 1e6:.1f}", f"{x['steps']}", f"{error:.1e}"]
+        cells.append(f"{r['springpot']['seconds_per_impact'] / r['dashpot']['seconds_per_impact']:.1f}x")
+        out.append("| " + " | ".join(cells) + " |")
+    out += ["", CONTROLLED_END]
+    return out
+
+
+def write(path, steps, precision, g1, alpha, package, springpot, controlled):
     h = steps["ns_per_step"]
     lit = steps["ns_literal_sum"]
     out = ["# Benchmarks", "",
@@ -1090,7 +1128,7 @@ def write(path, steps, precision, g1, alpha, package, springpot):
             f"wrong; for an odd number of points it also returns one value too few ({lengths} points; a missing "
             "point counts as off). `GLpoint` scales by (N+1)/(b-a) where the grid's step is (b-a)/N, an O(1/N) "
             "error. Ours is compiled and O(N) at the newest point; over the full grid it pays for the padding and "
-            "the direct head but is right at every point.", ""] + package + [""] + springpot
+            "the direct head but is right at every point.", ""] + package + [""] + springpot + [""] + controlled
     atomic.write_text(path, "\n".join(out) + "\n")
 
 
@@ -1098,11 +1136,11 @@ def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
     reports.add_fmu(parser)
-    parser.add_argument("--only", choices=["precision", "package", "springpot"],
+    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled"],
                         help="regenerate one section alone, in place (precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
                              "core; springpot: the springpot's memories, and the dashpot against the commit before "
-                             "them)")
+                             "them; controlled: the springpot against the dashpot under error control)")
     parser.add_argument("--largest-n", type=float, default=1e6,
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = reports.parse(parser, argv)
@@ -1124,6 +1162,12 @@ def main(argv=None, prog=None):
         replace_section(args.out / "benchmarks.md", section, SPRINGPOT_BEGIN, SPRINGPOT_END)
         print((args.out / "benchmarks.md").read_text())
         return
+    if args.only == "controlled":
+        say("the springpot under error control ...")
+        replace_section(args.out / "benchmarks.md", controlled_section(*controlled_rows(bench)), CONTROLLED_BEGIN,
+                        CONTROLLED_END)
+        print((args.out / "benchmarks.md").read_text())
+        return
     root = reports.source_tree()
     say("1/5 cost of a step ...")
     steps = step_costs(bench)
@@ -1135,6 +1179,8 @@ def main(argv=None, prog=None):
     package = package_section(*package_rows(program, bench))
     say("5/5 the springpot ...")
     springpot = springpot_section(springpot_rows(root, bench, args.fmu, args.largest_n))
-    write(args.out / "benchmarks.md", steps, precision_lines, g1, -0.5, package, springpot)
+    say("the springpot under error control ...")
+    controlled = controlled_section(*controlled_rows(bench))
+    write(args.out / "benchmarks.md", steps, precision_lines, g1, -0.5, package, springpot, controlled)
     print((args.out / "benchmarks.md").read_text())
 
