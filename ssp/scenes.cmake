@@ -7,7 +7,7 @@ file(GLOB scene_python "${CMAKE_SOURCE_DIR}/python/fraccontact/scenes/*.py")
 add_custom_command(OUTPUT "${scene_ssvs}/stamp"
   COMMAND "${CMAKE_COMMAND}" -E rm -rf "${scene_ssvs}"
   COMMAND "${CMAKE_COMMAND}" -E env "PYTHONPATH=${CMAKE_SOURCE_DIR}/python"
-          "FRACCONTACT_LIBRARY=$<TARGET_FILE:fraccontact_shared>"
+          "FRACCONTACT_LIBRARY=$<TARGET_FILE:fraccontact_shared>" ${PYTHON_SANITIZER_ENV}
           "${Python3_EXECUTABLE}" -m fraccontact.scenes.systems "${scene_ssvs}"
   COMMAND "${CMAKE_COMMAND}" -E touch "${scene_ssvs}/stamp"
   DEPENDS ${scene_python} fraccontact_shared
