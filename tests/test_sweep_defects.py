@@ -41,7 +41,7 @@ def every_case(plan):
 def no_cluster(monkeypatch):
     """sweep.main stops where it would start Dask, with the options and the
     plan it would run."""
-    def started(args, client, plan, *rest):
+    def started(args, client, cluster, plan, *rest):
         raise Started(args, plan)
     monkeypatch.setattr(cli, "connect", lambda args: (None, None))
     monkeypatch.setattr(cli, "close", lambda client, cluster: None)
