@@ -250,18 +250,57 @@ def partitions(out):
 
 @pytest.fixture(scope="module")
 def local_runs(tmp_path_factory):
-    """The same campaign on 1 and 2 local workers (the second with --csv)."""
+    """The same campaign on 1 and 2 local workers, threads (the second with
+    --csv), and on 2 worker processes."""
     out = tmp_path_factory.mktemp("local")
     assert sweep.main(MC + ["--workers", "1", "--out", str(out / "one")]) == 0
     assert sweep.main(MC + ["--workers", "2", "--csv", "--out", str(out / "two")]) == 0
-    return out / "one", out / "two"
+    assert sweep.main(MC + ["--workers", "2", "--processes", "--out", str(out / "processes")]) == 0
+    return out / "one", out / "two", out / "processes"
 
 
 def test_partitions_are_the_same_bytes_on_one_and_two_workers(local_runs):
-    one, two = local_runs
+    one, two, processes = local_runs
     names, data = partitions(one)
     assert names == ["part-000000.parquet", "part-000001.parquet", "part-000002.parquet"]
     assert partitions(two) == (names, data)
+    assert partitions(processes) == (names, data)
+    assert json.loads((processes / "sweep.json").read_text())["statistics"] == \
+        json.loads((one / "sweep.json").read_text())["statistics"]
+
+
+def test_library_calls_in_chunks_are_one_batch(monkeypatch):
+    """A task's cases in library calls of a few cases each (chunk sizes 3,
+    then at most 10) give fraccontact.impacts' results for the same
+    arrays in one batch, to the bit; a refused case is NaN in k with its
+    message, the others unmoved."""
+    monkeypatch.setattr(tasks, "FIRST", 3)
+    monkeypatch.setattr(tasks, "CHUNK", 10)
+    rng = np.random.default_rng(2)
+    c = rng.lognormal(np.log(6080), 0.1, 57)
+    k = rng.lognormal(np.log(3.3e8), 0.05, 57)
+    fixed = dict(law=2, dt_max=3e-6)
+    results, errors, _ = tasks.library_results(fixed, dict(c=c, k=k), 57)
+    truth = fraccontact.impacts(c=c, k=k, law="hertz", dt_max=3e-6)
+    for key in sweep.RESULTS:
+        assert results[key].tobytes() == np.asarray(getattr(truth, key)).astype(results[key].dtype).tobytes(), key
+    assert errors == {}
+    c[40] = -1.0
+    results, errors, _ = tasks.library_results(fixed, dict(c=c, k=k), 57)
+    assert list(errors) == [40] and "c" in errors[40] and np.isnan(results["k"][40])
+    assert np.delete(results["F_peak"], 40).tobytes() == np.delete(truth.F_peak, 40).tobytes()
+
+
+def test_a_monte_carlo_campaign_reads_no_partition_back(tmp_path, monkeypatch):
+    """The statistics and the histograms come from the tasks' summaries:
+    the sweep (its workers threads of this process) never reads a Parquet
+    file."""
+    def refused(*args, **kw):
+        raise AssertionError("a partition was read")
+    monkeypatch.setattr(pq, "read_table", refused)
+    monkeypatch.setattr(pq, "ParquetFile", refused)
+    assert sweep.main(MC + ["--workers", "2", "--out", str(tmp_path / "out")]) == 0
+    assert set(json.loads((tmp_path / "out" / "sweep.json").read_text())["statistics"]) >= {"F_peak", "eps"}
 
 
 def test_the_inputs_are_beside_the_library_results(local_runs):
@@ -280,7 +319,7 @@ def test_the_inputs_are_beside_the_library_results(local_runs):
 
 
 def test_the_csv_is_written_on_request_with_the_same_rows(local_runs):
-    one, two = local_runs
+    one, two, _ = local_runs
     assert not (one / "sweep.csv").exists()
     with open(two / "sweep.csv") as f:
         rows = list(csv.DictReader(f))
@@ -372,6 +411,8 @@ def test_a_scheduler_and_a_worker_started_as_processes(cluster, local_runs, tmp_
     remote = cluster(1)
     assert sweep.main(MC + ["--scheduler", remote.address, "--out", str(tmp_path / "out")]) == 0
     assert partitions(tmp_path / "out") == partitions(local_runs[0])
+    assert json.loads((tmp_path / "out" / "sweep.json").read_text())["statistics"] == \
+        json.loads((local_runs[0] / "sweep.json").read_text())["statistics"]
 
 
 def test_workers_without_the_package_are_refused_in_one_line(cluster, tmp_path, capsys):
