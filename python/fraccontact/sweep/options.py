@@ -318,7 +318,7 @@ def arguments(argv, prog):
     parser.add_argument("--processes", action="store_true",
                         help="local cluster: --workers processes of one thread instead of threads")
     parser.add_argument("--batch", type=int, default=0,
-                        help=f"impacts per Dask task, one library call (default: about {cases.TASKS} tasks, "
+                        help=f"impacts per Dask task (default: about {cases.TASKS} tasks, "
                              f"{cases.TASK_MIN} to {cases.TASK_MAX} impacts each)")
     parser.add_argument("--csv", action="store_true", help="also write every impact to sweep.csv")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("sweep"),

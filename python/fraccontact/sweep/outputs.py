@@ -168,7 +168,8 @@ def histograms(path, counted, stats, title):
         ax.set_ylim(top=1.4 * ax.get_ylim()[1])  # room for the legend above the bars
         ax.legend(fontsize=7, loc="upper right")
     fig.suptitle(title)
-    fig.tight_layout()
+    # Fixed margins: tight_layout would draw the figure once more to measure it.
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.88, wspace=0.3)
     atomic.save_figure(fig, path, dpi=100, metadata={"Software": None})
 
 

@@ -1,5 +1,5 @@
 """What a Dask task of a sweep does, on its worker: computes its cases from
-the plan and its index range, runs them in one library call, writes them,
+the plan and its index range, runs them in calls of the library, writes them,
 inputs beside results, as a Parquet partition (and a CSV part when asked),
 and returns a small summary: counts, the first refusals, and for a Monte
 Carlo campaign the statistics' summary of every numeric column (stats.py).
