@@ -37,15 +37,20 @@ def connect(args):
         # No dashboard; the scheduler's HTTP server (its metrics) on a free
         # port of the loopback, not on 8787, which another cluster may hold.
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
-        if not args.processes:
-            cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
+        # Dask's profiler samples every thread's stack every few milliseconds:
+        # CPU beside the tasks, growing with the campaign, for a profile
+        # nobody reads here.
+        with dask.config.set({"distributed.worker.profile.enabled": False}):
+            if not args.processes:
+                cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
+                return Client(cluster), cluster
+            # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which
+            # also keeps glibc from raising its mmap threshold: every array of
+            # a task would then come in fresh pages. The local workers keep
+            # glibc's own.
+            with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
             return Client(cluster), cluster
-        # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which also
-        # keeps glibc from raising its mmap threshold: every array of a task
-        # would then come in fresh pages. The local workers keep glibc's own.
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
-        return Client(cluster), cluster
     try:
         return Client(args.scheduler, timeout=options.CONNECT_TIMEOUT), None
     except ValueError as e:  # an address Dask cannot parse
