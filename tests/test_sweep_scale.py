@@ -172,7 +172,7 @@ def test_in_task_statistics_are_numpys_within_their_bound_on_hard_values(tmp_pat
     assert found["x"]["bound"] > 0  # 300 decades of both signs: bins of an eighth of a binade
 
 
-def test_in_task_percentiles_of_a_campaign_are_within_a_hundred_thousandth(tmp_path):
+def test_in_task_percentiles_of_a_campaign_are_within_an_eight_thousandth(tmp_path):
     """Log-normal columns as a campaign gives them (10 % scatter, in ten
     partitions), and one that crosses zero: 2^BITS bins over at most two
     binades' keys are each at most 2^(1 - BITS) of the larger binade, so
