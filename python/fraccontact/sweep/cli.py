@@ -218,11 +218,11 @@ def close(client, cluster):
 def stop(client, cluster):
     """Closes the client and the cluster, with a local cluster's threads'
     tasks stopped at their next library call."""
-    tasks.STOP.set()
+    tasks.STATE["stop"] = True
     try:
         close(client, cluster)
     finally:
-        tasks.STOP.clear()
+        tasks.STATE["stop"] = False
 
 
 def main(argv=None, prog=None):

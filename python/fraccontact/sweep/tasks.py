@@ -6,7 +6,6 @@ Carlo campaign the statistics' summary of every numeric column (stats.py).
 Nothing of the cases goes back to the client."""
 
 import ctypes
-import threading
 import time
 import warnings
 from dataclasses import dataclass
@@ -26,13 +25,14 @@ ERRORS_KEPT = 5  # refusals a summary carries, to be printed
 # Cases a library call runs: at most CHUNK, so that the batch's parameters
 # and outcomes stay a few megabytes however large the task, and about SLICE
 # seconds of them (a task of expensive impacts stops within that much of
-# STOP), starting from FIRST.
+# a stop), starting from FIRST.
 CHUNK = 1 << 14
 SLICE = 0.1
 FIRST = 64
-# Set by the client of a local cluster of threads when it stops (Ctrl-C):
-# a thread cannot be killed, so its task stops at its next library call.
-STOP = threading.Event()
+# STATE["stop"] is set by the client of a local cluster of threads when it
+# stops (Ctrl-C): a thread cannot be killed, so its task stops at its next
+# library call. A plain dict: the task's functions stay picklable by value.
+STATE = {"stop": False}
 ADDED = ("impacts", "failed", "seconds", "cpu_seconds", "library_cpu_seconds", "tasks")  # a summary's sums
 
 
@@ -128,7 +128,7 @@ def library_results(fixed, given, n):
     status = np.empty(n, dtype=OUTCOME["status"])
     cpu, a, b = 0.0, 0, min(FIRST, n)
     while a < n:
-        if STOP.is_set():
+        if STATE["stop"]:
             raise RuntimeError("the sweep stopped")
         batch = np.tile(shared, b - a)
         for name, x in given.items():
