@@ -316,7 +316,7 @@ def test_parameters_lists_what_the_readme_says():
 def test_sweep_json_holds_statistics_for_monte_carlo_only(tmp_path):
     """The README: counts and throughput, statistics for a Monte Carlo campaign
     (tests/test_sweep.py checks those statistics against numpy)."""
-    assert "`sweep/sweep.json` (for a Monte Carlo campaign also the mean, standard deviation" in PROSE
+    assert "for a Monte Carlo campaign also `statistics`: for every numeric column" in PROSE
     from fraccontact import sweep
     assert sweep.main(["--vary", "c=3000,6080", "--set", "law=hertz", "--workers", "1", "--out", str(tmp_path)]) in (0, None)
     assert "statistics" not in json.loads((tmp_path / "sweep.json").read_text())

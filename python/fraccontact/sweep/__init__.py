@@ -44,8 +44,8 @@ as is a negative S. Impact i's draws come from the seed, the parameter and
 i alone: the same on any cluster, whatever the workers and --batch.
 
 Each Dask task computes its own cases (its slice of the grid, or its draws),
-runs them in one call of the C library (fraccontact.impacts) and writes
-them itself: no case passes through the client, whose memory does not grow
+runs them in calls of the C library (as fraccontact.impacts does, a few
+thousand cases a call) and writes them itself: no case passes through the client, whose memory does not grow
 with the campaign. A campaign is refused before it starts when its output
 would not fit in the space free at --out (8 bytes a value in Parquet, 25
 in the CSV). Writes to --out:
@@ -66,19 +66,31 @@ in the CSV). Writes to --out:
                   task_cpu_seconds and library_cpu_seconds (the time
                   inside the tasks, their CPU, and the CPU of their
                   library calls, summed), statistics_seconds; for Monte
-                  Carlo also
-                  the mean, sample standard deviation and 5/50/95 %
-                  percentiles (exact: numpy's linear interpolation) of
+                  Carlo also the mean, sample standard deviation and
+                  5/50/95 % percentiles (numpy's linear interpolation,
+                  within `bound`, given for each column: see below) of
                   every numeric column over the impacts that succeeded,
-                  computed on the workers, and printed too.
+                  and printed too.
 The workers write into a hidden folder under --out, moved into place when
 the sweep ends: a failed or interrupted sweep leaves nothing.
 
-Runs on a local Dask cluster (--workers processes) or on any running Dask
-scheduler (--scheduler ADDRESS, refused when none answers there within 5 s;
---workers is the local cluster's), whose workers must import fraccontact
-(pip install .) and see --out (one machine, or a shared file system). A
-task whose worker dies runs again on another: the results are the same.
+The statistics are reduced inside the tasks: each task summarises its
+columns (count, mean, squared deviations; a histogram on bins of 2^-15 of
+the column's range of order-preserving keys, finer within a binade than
+across binades), the summaries merge on the workers, and the client reads
+no partition. The mean and std are exact to rounding; each percentile lies
+within `bound` of numpy's (the width of the bins it falls in: at most
+2^-13 of the column's largest value where its values lie within a factor of
+two; exact for integers and constants). The statistics are the same bits on
+any cluster.
+
+Runs on a local Dask cluster, by default one worker of --workers threads in
+this process (the library's calls and the Parquet writes release Python's
+GIL; default: the CPUs), or --workers processes with --processes; or on any
+running Dask scheduler (--scheduler ADDRESS, refused when none answers there
+within 5 s), whose workers must import fraccontact (pip install
+'.[sweep]') and see --out (one machine, or a shared file system). A task
+whose worker dies runs again on another: the results are the same.
 Every option is checked, and --out too, before the cluster starts. The wall
 time and the impacts per second count the Dask tasks alone, from the first
 given to the last finished (before, each worker has imported the package).

@@ -1,6 +1,7 @@
 """fraccontact sweep: the options checked, a Dask cluster, the tasks given a
-window at a time and their summaries folded on the workers, then the
-statistics (Monte Carlo), the CSV when asked, the plot and sweep.json."""
+window at a time and their summaries folded on the workers (the
+statistics' among them), then the CSV when asked, the plot and
+sweep.json."""
 
 import importlib
 import json
@@ -25,17 +26,31 @@ WINDOW = 2
 def connect(args):
     """(client, cluster): a Dask client of the scheduler at --scheduler
     (cluster None), refused in one line when none answers there within
-    CONNECT_TIMEOUT, or of a local cluster of --workers processes."""
+    CONNECT_TIMEOUT, or of a local cluster: one worker of --workers threads
+    in this process (the library's calls and pyarrow's writes release the
+    GIL, and nothing is copied between processes), or --workers processes
+    of one thread with --processes."""
     import dask
     from dask.distributed import Client, LocalCluster
     if not args.scheduler:
-        # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which also
-        # keeps glibc from raising its mmap threshold: every array of a task
-        # would then come in fresh pages. The local workers keep glibc's own.
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-            cluster = LocalCluster(n_workers=args.workers or options.WORKERS, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-        return Client(cluster), cluster
+        workers = args.workers or options.cpus()
+        # No dashboard; the scheduler's HTTP server (its metrics) on a free
+        # port of the loopback, not on 8787, which another cluster may hold.
+        quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
+        # Dask's profiler samples every thread's stack every few milliseconds:
+        # CPU beside the tasks, growing with the campaign, for a profile
+        # nobody reads here.
+        with dask.config.set({"distributed.worker.profile.enabled": False}):
+            if not args.processes:
+                cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
+                return Client(cluster), cluster
+            # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which
+            # also keeps glibc from raising its mmap threshold: every array of
+            # a task would then come in fresh pages. The local workers keep
+            # glibc's own.
+            with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
+            return Client(cluster), cluster
     try:
         return Client(args.scheduler, timeout=options.CONNECT_TIMEOUT), None
     except ValueError as e:  # an address Dask cannot parse
@@ -125,18 +140,10 @@ def simulate(args, client, plan, size, folder):
         return summary, time.perf_counter() - start
 
 
-def run_pass(client, plan, folder, count):
-    """run_pass(requests) for stats.summaries: a pass over every partition,
-    folded on the workers, finished there."""
-    def over_partitions(requests):
-        calls = ((0, stats.partition_pass, plan.path(folder, i, "parquet"), requests) for i in range(count))
-        folded = fold(client, calls, stats.combined, window(client))
-        return client.submit(stats.finished, folded, requests, pure=False).result()
-    return over_partitions
-
-
-def run(args, client, plan, size, prog):
-    """The sweep on the cluster, its outputs written; its exit status."""
+def run(args, client, cluster, plan, size, prog):
+    """The sweep on the cluster, its outputs written; its exit status. On
+    any error, the cluster is closed, its tasks stopped, before what they
+    wrote is removed."""
     staging = outputs.Staging(args.out)
     try:
         blind = unseen(client, staging.folder)
@@ -155,18 +162,16 @@ def run(args, client, plan, size, prog):
         outputs.preload()
         summary, wall = simulate(args, client, plan, size, staging.folder)
         count = len(range(0, plan.cases.n, size))
-        monte_carlo = args.monte_carlo is not None
-        statistics, counted = {}, {}
         began = time.perf_counter()
-        if monte_carlo and summary["failed"] < summary["impacts"]:
-            bins = outputs.histogram_bins(summary["impacts"] - summary["failed"])
-            statistics, counted = stats.summaries(summary["moments"], run_pass(client, plan, staging.folder, count),
-                                                  [(key, bins) for key, *_ in outputs.PLOTTED])
+        statistics = stats.statistics(summary["statistics"])
+        bins = outputs.histogram_bins(summary["impacts"] - summary["failed"])
+        counted = {key: stats.histogram(summary["statistics"][key], bins) for key, *_ in outputs.PLOTTED
+                   if key in summary["statistics"]}
         statistics_seconds = time.perf_counter() - began
         written = write(args, plan, staging, count, summary, statistics, counted)
         result = dict(impacts=summary["impacts"], failed=summary["failed"], wall_seconds=wall,
                       impacts_per_second=summary["impacts"] / wall,
-                      workers=None if args.scheduler else args.workers or options.WORKERS, tasks=count,
+                      workers=None if args.scheduler else args.workers or options.cpus(), tasks=count,
                       task_seconds=summary["seconds"], task_cpu_seconds=summary["cpu_seconds"],
                       library_cpu_seconds=summary["library_cpu_seconds"],
                       statistics_seconds=statistics_seconds)
@@ -174,6 +179,7 @@ def run(args, client, plan, size, prog):
                           json.dumps(dict(result, statistics=statistics) if statistics else result) + "\n")
         staging.commit(written | {"sweep.json"})
     except BaseException:
+        stop(client, cluster)
         staging.discard()
         raise
     if statistics:
@@ -209,6 +215,16 @@ def close(client, cluster):
         cluster.close()
 
 
+def stop(client, cluster):
+    """Closes the client and the cluster, with a local cluster's threads'
+    tasks stopped at their next library call."""
+    tasks.STATE["stop"] = True
+    try:
+        close(client, cluster)
+    finally:
+        tasks.STATE["stop"] = False
+
+
 def main(argv=None, prog=None):
     parser, args = options.arguments(argv, prog)
     try:
@@ -223,7 +239,7 @@ def main(argv=None, prog=None):
         parser.error(str(e))
     from distributed import KilledWorker
     try:
-        return run(args, client, plan, size, parser.prog)
+        return run(args, client, cluster, plan, size, parser.prog)
     except OSError as e:
         print(f"{parser.prog}: --out {args.out}: cannot write the results: {e.strerror or e}", file=sys.stderr)
         return 2

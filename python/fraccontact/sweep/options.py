@@ -21,7 +21,6 @@ DEFAULT_HEIGHTS = "0.005:0.1:0.005"
 # How long --scheduler waits for its scheduler to answer [s]: a scheduler
 # that is up answers at once, and a wrong address should not cost longer.
 CONNECT_TIMEOUT = 5
-WORKERS = 2  # the local cluster's worker processes by default
 HEIGHT = dict(name="height", kind="real", unit="m", default=None, help="drop height: v = sqrt(2 g h)")
 # What --out receives: the partitions' folder, and the files.
 PARTITIONS = "sweep.parquet"
@@ -217,9 +216,12 @@ def refuse_conflicts(args, vary, fixed, scattered):
     if args.workers is not None and args.scheduler:
         raise ValueError(f"--workers {args.workers} with --scheduler: the scheduler's workers run the sweep; "
                          "--workers sizes the local cluster")
+    if args.processes and args.scheduler:
+        raise ValueError("--processes with --scheduler: the scheduler's workers run the sweep; --processes makes "
+                         "the local cluster's workers processes")
     if args.workers is not None and not 1 <= args.workers <= cpus():
-        raise ValueError(f"--workers {args.workers}: a local cluster has 1 to {cpus()} worker processes, this "
-                         "machine's CPUs (more would only compete for them)")
+        raise ValueError(f"--workers {args.workers}: a local cluster has 1 to {cpus()} workers, this machine's "
+                         "CPUs (more would only compete for them)")
     if args.batch < 0:
         raise ValueError(f"--batch {args.batch}: impacts per Dask task, >= 1 (or 0, the default)")
 
@@ -311,9 +313,12 @@ def arguments(argv, prog):
     parser.add_argument("--seed", type=int, help="--monte-carlo: the random generator's seed (default 1)")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
     parser.add_argument("--workers", type=int,
-                        help=f"local cluster: worker processes (default {WORKERS}, at most the CPUs)")
+                        help="local cluster: its workers, threads of this process (default: the CPUs, at most as "
+                             "many)")
+    parser.add_argument("--processes", action="store_true",
+                        help="local cluster: --workers processes of one thread instead of threads")
     parser.add_argument("--batch", type=int, default=0,
-                        help=f"impacts per Dask task, one library call (default: about {cases.TASKS} tasks, "
+                        help=f"impacts per Dask task (default: about {cases.TASKS} tasks, "
                              f"{cases.TASK_MIN} to {cases.TASK_MAX} impacts each)")
     parser.add_argument("--csv", action="store_true", help="also write every impact to sweep.csv")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("sweep"),

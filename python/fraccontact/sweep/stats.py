@@ -1,92 +1,38 @@
-"""Statistics of a Monte Carlo campaign, computed on the workers over its
-Parquet partitions, over the impacts that succeeded and where the figure
-exists (an impact that did not end by t_end has no eps):
+"""Statistics of a Monte Carlo campaign, reduced inside the tasks: each task
+summarises every numeric column of its partition, over the impacts that
+succeeded and where the figure exists (an impact that did not end by t_end
+has no eps), and the summaries merge on the workers, so that the client
+receives one small summary and reads no partition:
 
-- the mean and the sample standard deviation, merged from each partition's
-  count, mean and sum of squared deviations (Chan, Golub and LeVeque's
-  pairwise update), which each task computes from its own results;
-- the 5, 50 and 95 % percentiles exact, as numpy's linear interpolation
-  gives them over all the values: the order statistics they need are found
-  by passes over the partitions, each counting the values in 2^BITS bins of
-  the range still open, with each bin's smallest and largest (the bins
-  taken on the doubles' order-preserving 64-bit keys, so that a pass
-  narrows any range, however many decades it spans, by 2^BITS at least),
-  until the bin holding the rank holds one value, or at most GATHER, which
-  are then gathered and the rank selected among them;
-- the histograms of the plotted results, on the first of those passes.
+- the count, mean and sum of squared deviations of each task, merged in
+  the tasks' order by Chan, Golub and LeVeque's pairwise update: the mean
+  and the sample standard deviation, the same bits whatever the workers
+  and the order their summaries merge in; the smallest and the largest;
+- a histogram on dyadic bins of the doubles' order-preserving 64-bit keys:
+  bin b at shift s holds the keys b 2^s to (b + 1) 2^s - 1, so that two
+  histograms merge exactly (the finer one's bins summed into the
+  coarser's), the shift the smallest that keeps a column's bins at most
+  2^BITS. Keys grow with the exponent and then the mantissa: the bins are
+  uniform within a binade and logarithmic across binades, so that a column
+  spanning decades costs little resolution.
 
-The client holds only the counts of the bins and the values selected."""
+The 5, 50 and 95 % percentiles are numpy's linear interpolation between two
+order statistics, each found in its bin by the counts and placed inside it
+by its rank, as though the bin's values were evenly spread. Each order
+statistic lies in its bin, clipped to the column's smallest and largest
+(and, for an integer column, to the integers inside): a percentile is
+within `bound` of numpy's, the widths of the bins it interpolates between,
+weighted as it weighs them; sweep.json gives that bound for each column.
+A bin that holds one value (a constant column, an integer column's
+integers) gives it exactly. The plot's histograms group the same bins."""
+
+from dataclasses import dataclass
 
 import numpy as np
-import pyarrow.parquet as pq
 
 QUANTILES = (0.05, 0.5, 0.95)
-BITS = 12
-GATHER = 1 << 16
+BITS = 15
 SIGN = np.uint64(1 << 63)
-NO_KEY = np.uint64((1 << 64) - 1)
-# A pass narrows a range of 2^64 keys by 2^BITS: 6 passes reach one key.
-PASSES = -(-64 // BITS) + 1
-
-
-def numeric(table):
-    """The numeric columns of a partition (not the words, not error)."""
-    return [f.name for f in table.schema if f.type in ("double", "int64")]
-
-
-def values(table, name, ok):
-    """A column's finite values of the impacts that succeeded (ok: None
-    for all), as doubles; copied only where some are left out."""
-    x = table.column(name).to_numpy()
-    if ok is not None:
-        x = x[ok]
-    x = x.astype(np.float64, copy=False)
-    if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
-        x = x[np.isfinite(x)]
-    return x
-
-
-def succeeded(table):
-    """Which impacts succeeded, or None for all."""
-    error = table.column("error")
-    return None if error.null_count == len(error) else error.is_null().to_numpy(zero_copy_only=False)
-
-
-def moments(columns, failed):
-    """{column: (count, mean, sum of squared deviations, min, max)} of the
-    numeric columns ({name: array}) over the cases not failed (indices),
-    where they have values."""
-    ok = np.ones(len(next(iter(columns.values()))), dtype=bool)
-    ok[failed] = False
-    out = {}
-    for name, x in columns.items():
-        if x.dtype.kind not in "fi":
-            continue
-        x = x.astype(np.float64, copy=False)
-        if len(failed):
-            x = x[ok]
-        if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
-            x = x[np.isfinite(x)]
-        if len(x):
-            mean = x.mean()
-            deviations = x - mean
-            out[name] = (len(x), mean, float(np.square(deviations, out=deviations).sum()), float(x.min()),
-                         float(x.max()))
-    return out
-
-
-def merged_moments(a, b):
-    """The moments of two sets of values from theirs (Chan et al.)."""
-    out = dict(a)
-    for name, (nb, mb, sb, lob, hib) in b.items():
-        if name not in out:
-            out[name] = (nb, mb, sb, lob, hib)
-            continue
-        na, ma, sa, loa, hia = out[name]
-        n = na + nb
-        delta = mb - ma
-        out[name] = (n, ma + delta * nb / n, sa + sb + delta * delta * na * nb / n, min(loa, lob), max(hia, hib))
-    return out
 
 
 def key(x):
@@ -98,10 +44,106 @@ def key(x):
     return np.where(bits >> np.uint64(63) == 1, ~bits, bits | SIGN)
 
 
-def double(k):
-    """The double of a key."""
-    k = np.uint64(k)
-    return float(np.array(k & ~SIGN if k >> np.uint64(63) == 1 else ~k, dtype=np.uint64).view(np.float64))
+def doubles(k):
+    """The doubles of keys."""
+    k = np.asarray(k, dtype=np.uint64)
+    return np.where(k >> np.uint64(63) == 1, k & ~SIGN, ~k).view(np.float64)
+
+
+def fitting_shift(low, high, shift=0):
+    """The smallest shift >= shift at which the keys low to high fall in at
+    most 2^BITS bins."""
+    shift = max(shift, (high - low).bit_length() - BITS)
+    while (high >> shift) - (low >> shift) >= 1 << BITS:
+        shift += 1
+    return shift
+
+
+@dataclass
+class Summary:
+    """A column's summary: {task: (count, mean, sum of squared deviations)},
+    the smallest and largest value, the histogram (its shift, its first bin,
+    the counts by bin), whether the column holds integers."""
+    moments: dict
+    smallest: float
+    largest: float
+    shift: int
+    first: int
+    counts: np.ndarray
+    integer: bool
+
+
+def summary(x, integer, task):
+    """The Summary of a task's values x of a column (doubles, finite)."""
+    mean = x.mean()
+    deviations = x - mean
+    squares = float(np.square(deviations, out=deviations).sum())
+    k = key(x)
+    low, high = int(k.min()), int(k.max())
+    shift = fitting_shift(low, high)
+    first = low >> shift
+    bins = ((k >> np.uint64(shift)) - np.uint64(first)).astype(np.intp)
+    return Summary({task: (len(x), float(mean), squares)}, float(x.min()), float(x.max()), shift, first,
+                   np.bincount(bins), integer)
+
+
+def reduced(columns, failed, task=0):
+    """{column: Summary} of the numeric columns ({name: array}) of task
+    `task` over the cases not failed (indices), where they have values (not
+    NaN, not infinite)."""
+    ok = None
+    if len(failed):
+        ok = np.ones(len(next(iter(columns.values()))), dtype=bool)
+        ok[failed] = False
+    out = {}
+    for name, x in columns.items():
+        if x.dtype.kind not in "fi":
+            continue
+        integer = x.dtype.kind == "i"
+        x = x.astype(np.float64, copy=False)
+        if ok is not None:
+            x = x[ok]
+        if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
+            x = x[np.isfinite(x)]
+        if len(x):
+            out[name] = summary(x, integer, task)
+    return out
+
+
+def merged(*summaries):
+    """The summaries ({column: Summary}) of several tasks as one."""
+    out = {}
+    for summary_ in summaries:
+        for name, s in summary_.items():
+            out[name] = both(out[name], s) if name in out else s
+    return out
+
+
+def both(a, b):
+    low = min(a.first << a.shift, b.first << b.shift)
+    high = max(((a.first + len(a.counts)) << a.shift) - 1, ((b.first + len(b.counts)) << b.shift) - 1)
+    shift = fitting_shift(low, high, max(a.shift, b.shift))
+    first = low >> shift
+    counts = np.zeros((high >> shift) - first + 1, dtype=np.int64)
+    for s in (a, b):
+        bins = ((np.uint64(s.first) + np.arange(len(s.counts), dtype=np.uint64)) >> np.uint64(shift - s.shift)) \
+            - np.uint64(first)
+        counts += np.bincount(bins.astype(np.intp), weights=s.counts, minlength=len(counts)).astype(np.int64)
+    return Summary({**a.moments, **b.moments}, min(a.smallest, b.smallest), max(a.largest, b.largest), shift, first,
+                   counts, a.integer)  # the bincount's doubles hold the counts exactly (below 2^53)
+
+
+def moments(s):
+    """(count, mean, sum of squared deviations) of all the tasks, merged in
+    their order."""
+    tasks = sorted(s.moments)
+    n, mean, squares = s.moments[tasks[0]]
+    for task in tasks[1:]:
+        nb, mb, sb = s.moments[task]
+        total = n + nb
+        delta = mb - mean
+        n, mean, squares = total, mean + delta * nb / total, squares + sb + delta * delta * n * nb / total
+    return n, mean, squares
 
 
 def ranks(n, q):
@@ -119,135 +161,57 @@ def lerp(a, b, t):
     return b - (b - a) * (1 - t) if t >= 0.5 else a + (b - a) * t
 
 
-def shift(low, high):
-    """The bin of key k in [low, high] is (k - low) >> shift: at most 2^BITS bins."""
-    return max(0, (high - low).bit_length() - BITS)
+def edges(s, b):
+    """(low, high): the values bins b (an array) of a Summary can hold, their
+    keys clipped to the column's smallest and largest, and to the integers
+    inside for an integer column."""
+    b = np.asarray(b, dtype=np.uint64) + np.uint64(s.first)
+    ends = key(np.array([s.smallest, s.largest]))
+    low = doubles(np.maximum(b << np.uint64(s.shift), ends[0]))
+    high = doubles(np.minimum(((b + np.uint64(1)) << np.uint64(s.shift)) - np.uint64(1), ends[1]))
+    if s.integer:
+        return np.ceil(low), np.floor(high)
+    return low, high
 
 
-def partition_pass(path, requests):
-    """One partition's part of a pass: for each request ("bins", column,
-    low, high) the count, the smallest and the largest of its keys in [low,
-    high] by bin, ("gather", column, low, high, picks) those keys, ("hist",
-    column, low, high, bins) numpy's histogram of its values."""
-    table = pq.read_table(path, columns=sorted({r[1] for r in requests}) + ["error"])
-    ok = succeeded(table)
-    columns = {}
-    out = []
-    for kind, name, low, high, *rest in requests:
-        if name not in columns:
-            x = values(table, name, ok)
-            columns[name] = (x, key(x))
-        x, k = columns[name]
-        if kind == "hist":
-            out.append(np.histogram(x, bins=rest[0], range=(low, high))[0])
-            continue
-        inside = k[(k >= np.uint64(low)) & (k <= np.uint64(high))]
-        if kind == "gather":
-            out.append(inside)
-        else:
-            out.append(binned(inside, low, high))
-    return out
+def order_statistic(s, cumulative, rank):
+    """The value of rank `rank` (0 the smallest), placed in its bin, and
+    the bin's width."""
+    b = int(np.searchsorted(cumulative, rank, side="right"))
+    below = int(cumulative[b - 1]) if b else 0
+    low, high = (float(x[0]) for x in edges(s, [b]))
+    position = (rank - below + 0.5) / s.counts[b]
+    return (low + (high - low) * position if high > low else low), high - low
 
 
-def binned(k, low, high):
-    """(count, smallest, largest) of the keys k by bin of [low, high]; an
-    empty bin's smallest is the largest key and its largest 0."""
-    bins = ((k - np.uint64(low)) >> np.uint64(shift(low, high))).astype(np.int64)
-    size = ((high - low) >> shift(low, high)) + 1
-    smallest, largest = np.full(size, NO_KEY, dtype=np.uint64), np.zeros(size, dtype=np.uint64)
-    np.minimum.at(smallest, bins, k)
-    np.maximum.at(largest, bins, k)
-    return np.bincount(bins, minlength=size), smallest, largest
-
-
-def combined(*parts):
-    """Passes over several partitions as one: counts added, keys joined,
-    the smallest and largest of each bin kept."""
-    return [joined(xs) for xs in zip(*parts)]
-
-
-def joined(xs):
-    if isinstance(xs[0], tuple):
-        counts, smallest, largest = zip(*xs)
-        return np.sum(counts, axis=0), np.minimum.reduce(smallest), np.maximum.reduce(largest)
-    return np.concatenate(xs) if xs[0].dtype == np.uint64 else np.sum(xs, axis=0)
-
-
-def finished(result, requests):
-    """A pass's result as the client needs it: the counts, and for a
-    gather the keys of the ranks it picks (selected here, on a worker)."""
-    return [np.partition(x, r[4])[list(r[4])] if r[0] == "gather" else x for x, r in zip(result, requests)]
-
-
-def summaries(moments, run_pass, histograms=()):
-    """{column: dict(mean, std, p5, p50, p95)} (std None for one value) from
-    the merged moments, and {column: (counts, low, high)} of the
-    histograms asked for ((column, bins), ...); run_pass(requests) returns
-    finished() of a pass over all partitions."""
-    # Each wanted order statistic: its open key range [low, high], the values below it, and the values inside.
-    wanted = {}
-    for name, (n, *_, low, high) in moments.items():
-        for q in QUANTILES:
-            for rank in ranks(n, q)[:2]:
-                wanted[(name, rank)] = [int(key(np.array([low]))[0]), int(key(np.array([high]))[0]), 0, n]
-    found = {}
-    extra = [("hist", name, moments[name][3], moments[name][4], bins) for name, bins in histograms if name in moments]
-    plotted = {}
-    for _ in range(PASSES + 1):  # each pass narrows a range by 2^BITS: the last leaves one key
-        for target, (low, high, below, count) in wanted.items():
-            if low == high:
-                found.setdefault(target, double(low))
-        open_ = {t: s for t, s in wanted.items() if t not in found}
-        if not open_ and not extra:
-            break
-        requests, picks = request_pass(open_)
-        results = run_pass(requests + extra)
-        for r, counts in zip(extra, results[len(requests):]):
-            plotted[r[1]] = (counts, r[2], r[3])
-        extra = []
-        settle(wanted, found, requests, picks, results)
-    return {name: statistics_of(name, moments[name], found) for name in moments}, plotted
-
-
-def request_pass(open_):
-    """The requests of the next pass: a gather where few values remain in
-    the range, else its bins; picks maps each target to its request and,
-    for a gather, its position in the pick list."""
-    requests, index, picks = [], {}, {}
-    for target, (low, high, below, count) in open_.items():
-        kind = "gather" if count <= GATHER else "bins"
-        where = (kind, target[0], low, high)
-        if where not in index:
-            index[where] = len(requests)
-            requests.append([kind, target[0], low, high, []])
-        r = requests[index[where]]
-        if kind == "gather":
-            picks[target] = (index[where], len(r[4]))
-            r[4].append(target[1] - below)
-        else:
-            picks[target] = (index[where], None)
-    return [tuple(r[:4]) if r[0] == "bins" else (r[0], r[1], r[2], r[3], tuple(r[4])) for r in requests], picks
-
-
-def settle(wanted, found, requests, picks, results):
-    """Each target after a pass: its value where gathered, else its range
-    narrowed to the keys in the bin holding its rank (one key: found)."""
-    for target, (i, pick) in picks.items():
-        if requests[i][0] == "gather":
-            found[target] = double(results[i][pick])
-            continue
-        counts, smallest, largest = results[i]
-        below = wanted[target][2]
-        cumulative = np.cumsum(counts)
-        b = int(np.searchsorted(cumulative, target[1] - below, side="right"))
-        wanted[target] = [int(smallest[b]), int(largest[b]), below + (int(cumulative[b - 1]) if b else 0),
-                          int(counts[b])]
-
-
-def statistics_of(name, m, found):
-    n, mean, squares, _, _ = m
-    out = dict(mean=float(mean), std=float(np.sqrt(squares / (n - 1))) if n > 1 else None)
+def statistics_of(s):
+    """dict(mean, std (None for one value), p5, p50, p95, bound) of a
+    Summary."""
+    n, mean, squares = moments(s)
+    out = dict(mean=mean, std=float(np.sqrt(squares / (n - 1))) if n > 1 else None)
+    cumulative = np.cumsum(s.counts)
+    bound = 0.0
     for q in QUANTILES:
         previous, following, gamma = ranks(n, q)
-        out[f"p{round(100 * q)}"] = lerp(found[(name, previous)], found[(name, following)], gamma)
+        (a, width_a), (b, width_b) = order_statistic(s, cumulative, previous), order_statistic(s, cumulative, following)
+        out[f"p{round(100 * q)}"] = float(lerp(a, b, gamma))
+        bound = max(bound, (1 - gamma) * width_a + gamma * width_b)
+    out["bound"] = float(bound)
     return out
+
+
+def statistics(summaries):
+    """{column: statistics_of()} of the merged summaries."""
+    return {name: statistics_of(s) for name, s in summaries.items()}
+
+
+def histogram(s, bins):
+    """(counts, low, high): a Summary's values in `bins` equal bins over
+    [smallest, largest], each of its own bins counted in the one holding
+    its middle (a bin's values cross an edge by at most its width)."""
+    low, high = edges(s, np.flatnonzero(s.counts))
+    width = (s.largest - s.smallest) / bins
+    which = ((low + high) / 2 - s.smallest) / width if width > 0 else np.zeros(len(low))
+    which = np.clip(which.astype(np.int64), 0, bins - 1)
+    return np.bincount(which, weights=s.counts[s.counts > 0], minlength=bins).astype(np.int64), s.smallest, \
+        s.largest

@@ -1,8 +1,9 @@
 """What a Dask task of a sweep does, on its worker: computes its cases from
-the plan and its index range, runs them in one library call, writes them,
+the plan and its index range, runs them in calls of the library, writes them,
 inputs beside results, as a Parquet partition (and a CSV part when asked),
-and returns a small summary: counts, the first refusals, the moments of
-every numeric column. Nothing of the cases goes back to the client."""
+and returns a small summary: counts, the first refusals, and for a Monte
+Carlo campaign the statistics' summary of every numeric column (stats.py).
+Nothing of the cases goes back to the client."""
 
 import ctypes
 import time
@@ -11,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.csv
 import pyarrow.parquet as pq
 
 from .. import _lib, atomic, model
@@ -22,6 +22,17 @@ from . import stats
 RESULTS = model.IMPACT_FIGURES + ("impacts", "steps", "k")
 COUNTS = ("impacts", "steps")
 ERRORS_KEPT = 5  # refusals a summary carries, to be printed
+# Cases a library call runs: at most CHUNK, so that the batch's parameters
+# and outcomes stay a few megabytes however large the task, and about SLICE
+# seconds of them (a task of expensive impacts stops within that much of
+# a stop), starting from FIRST.
+CHUNK = 1 << 14
+SLICE = 0.1
+FIRST = 64
+# STATE["stop"] is set by the client of a local cluster of threads when it
+# stops (Ctrl-C): a thread cannot be killed, so its task stops at its next
+# library call. A plain dict: the task's functions stay picklable by value.
+STATE = {"stop": False}
 ADDED = ("impacts", "failed", "seconds", "cpu_seconds", "library_cpu_seconds", "tasks")  # a summary's sums
 
 
@@ -34,7 +45,7 @@ class Plan:
     fixed: dict
     schema: pa.Schema
     width: int  # digits of a partition's number: the files sort in case order
-    statistics: bool  # whether the tasks return their columns' moments (Monte Carlo)
+    statistics: bool  # whether the tasks summarise their columns for the statistics (Monte Carlo)
 
     def path(self, folder, index, suffix):
         return folder / f"part-{index:0{self.width}d}.{suffix}"
@@ -62,21 +73,19 @@ def run(plan, index, start, stop, folder, csv):
     write(table, plan, folder, index, csv)
     failed = sorted(errors)
     columns = dict(zip(plan.schema.names, [*shown.values(), *results.values()]))
-    moments = stats.moments(columns, failed) if plan.statistics else {}
+    summaries = stats.reduced(columns, failed, index) if plan.statistics else {}
     return dict(impacts=stop - start, failed=len(failed), seconds=time.perf_counter() - began,
                 cpu_seconds=time.thread_time() - cpu, library_cpu_seconds=library_cpu, tasks=1,
                 errors=[(start + i, {name: column[i].item() for name, column in shown.items()}, errors[i])
-                        for i in failed[:ERRORS_KEPT]], moments=moments)
+                        for i in failed[:ERRORS_KEPT]], statistics=summaries)
 
 
 def merged(*summaries):
     """The summary of several tasks: counts and times added, the first
-    refusals kept, the moments merged."""
-    moments = {}
-    for s in summaries:
-        moments = stats.merged_moments(moments, s["moments"])
+    refusals kept, the statistics' summaries merged."""
+    statistics = stats.merged(*(s["statistics"] for s in summaries))
     errors = sorted((e for s in summaries for e in s["errors"]), key=lambda e: e[0])[:ERRORS_KEPT]
-    return dict({key: sum(s[key] for s in summaries) for key in ADDED}, errors=errors, moments=moments)
+    return dict({key: sum(s[key] for s in summaries) for key in ADDED}, errors=errors, statistics=statistics)
 
 
 PARAMS, OUTCOME = np.dtype(_lib.Params), np.dtype(_lib.Outcome)
@@ -105,29 +114,48 @@ def velocities(height):
 
 def library_results(fixed, given, n):
     """The RESULTS of the cases whose parameters are the arrays in given
-    (fixed holds the rest; a draw replaces its nominal value), in one call
-    of the library's fc_run_batch; {index: the library's message} of the
-    cases it refused (their results NaN, or 0 for the counts); the CPU
-    seconds of the library call. The library is called directly, without
+    (fixed holds the rest; a draw replaces its nominal value), in calls of
+    the library's fc_run_batch (chunk() cases each); {index: the library's
+    message} of the cases it refused (their results NaN, or 0 for the
+    counts); the CPU seconds of the library calls. The library is called directly, without
     the Python objects fraccontact.impacts makes for each case (the stop's
     word, its checks), which would cost time beside every impact; a
     refused case's message is still fraccontact.impacts' own, from that
     case alone."""
-    batch = np.tile(record(fixed, given), n)
-    for name, x in given.items():
-        batch["v" if name == "height" else name] = velocities(x) if name == "height" else x
-    out = np.zeros(n, dtype=OUTCOME)
-    cpu = time.thread_time()
-    _lib.LIB.fc_run_batch(n, batch.ctypes.data, out.ctypes.data)
-    cpu = time.thread_time() - cpu
-    ended = out["impacts"] > 0
-    results = {name: np.where(ended, out["first"][name], np.nan) for name in model.IMPACT_FIGURES}
-    results.update(impacts=out["impacts"], steps=out["steps"], k=out["k"])
-    refused = np.flatnonzero(out["status"] != _lib.FC_OK)
+    shared = record(fixed, given)
+    results = {name: np.empty(n) for name in model.IMPACT_FIGURES}
+    results.update(impacts=np.empty(n, dtype=np.int64), steps=np.empty(n, dtype=np.int64), k=np.empty(n))
+    status = np.empty(n, dtype=OUTCOME["status"])
+    cpu, a, b = 0.0, 0, min(FIRST, n)
+    while a < n:
+        if STATE["stop"]:
+            raise RuntimeError("the sweep stopped")
+        batch = np.tile(shared, b - a)
+        for name, x in given.items():
+            batch["v" if name == "height" else name] = velocities(x[a:b]) if name == "height" else x[a:b]
+        out = np.zeros(b - a, dtype=OUTCOME)
+        began = time.thread_time()
+        _lib.LIB.fc_run_batch(b - a, batch.ctypes.data, out.ctypes.data)
+        spent = time.thread_time() - began
+        cpu += spent
+        ended = out["impacts"] > 0
+        for name in model.IMPACT_FIGURES:
+            results[name][a:b] = np.where(ended, out["first"][name], np.nan)
+        for name in ("impacts", "steps", "k"):
+            results[name][a:b] = out[name]
+        status[a:b] = out["status"]
+        a, b = b, min(b + chunk(b - a, spent), n)
+    refused = np.flatnonzero(status != _lib.FC_OK)
     results["k"][refused] = np.nan
-    errors = {int(i): refusal({**fixed, **{name: x[i] for name, x in given.items()}}, out["status"][i])
+    errors = {int(i): refusal({**fixed, **{name: x[i] for name, x in given.items()}}, status[i])
               for i in refused}
     return results, errors, cpu
+
+
+def chunk(cases, seconds):
+    """The cases of the next library call: about SLICE seconds at the pace
+    of the last, CHUNK at most."""
+    return min(CHUNK, max(1, int(SLICE * cases / seconds))) if seconds > 0 else CHUNK
 
 
 def messages(errors, n):
@@ -158,5 +186,6 @@ def write(table, plan, folder, index, csv):
         # Random doubles neither compress nor fit a dictionary: trying costs most of a write.
         pq.write_table(table, f, use_dictionary=False, compression="none")
     if csv:
+        import pyarrow.csv  # only asked for with --csv
         with atomic.replacing(plan.path(folder, index, "csv"), "wb") as f:
             pyarrow.csv.write_csv(table, f)
