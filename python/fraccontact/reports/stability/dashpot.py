@@ -49,9 +49,11 @@ _ENERGY_RUNS = [("c = 1e+07", "hertz"), ("c = 1e+09", "hertz"), ("m = 0.001", "h
                 ("corner c 1e+09, E_s 1e+06, v0 0.0001, m 1000, dt 0.01", "hertz"),
                 ("corner c 1e+09, E_s 1e+06, v0 30, m 0.001, dt 1e-07", "hertz"),
                 ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 1e-07", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 30, m 0.001, dt 0.01", "hertz")]
+                ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 0.01", "hertz"),
+                ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 1000, dt 0.01", "hertz"),
+                ("corner c 1e+09, E_s 2.1e+11, v0 30, m 0.001, dt 0.01", "hertz"),
+                ("corner c 1e+09, E_s 2.1e+11, v0 30, m 1000, dt 0.01", "hertz")]
 _ENERGY_EPS_RUNS = [("corner c 1e+09, E_s 1e+06, v0 30, m 1000, dt 0.01", "hertz"),
-                    ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 1000, dt 0.01", "hertz"),
                     ("corner c 1e+09, E_s 2.1e+11, v0 30, m 0.001, dt 1e-07", "hertz")]
 _FORCE_CASES = ["corner c 0.01, E_s 1e+06, v0 0.0001, m 0.001, dt 0.01",
                 "corner c 0.01, E_s 1e+06, v0 0.0001, m 1000, dt 0.01",
