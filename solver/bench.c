@@ -213,13 +213,14 @@ typedef struct {
     size_t modes;          /* the compressed memory's M */
 } impact_run;
 
-/* One h20 impact from t = 0 in calls of 100 internal steps of dt_max, as an
+/* One h20 impact from t = 0 in calls of 100 internal steps (of dt_max, or the
+ * default step where dt_max is 0), as an
  * FMU takes them: until the first impact ends (span 0), or over exactly
  * `span` (a whole number of calls). 0, or -1 when a call fails. */
 static int run_impact(const contact_params *p, double span, impact_run *out)
 {
     contact_model cm;
-    double v0, m, H = 100.0 * p->dt_max, t0;
+    double v0, m, H = 100.0 * contact_step_limit(p), t0;
     long calls = span > 0.0 ? lround(span / H) : 0, i;
     char why[512];
     int failed = 0;

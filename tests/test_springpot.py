@@ -1075,3 +1075,20 @@ def test_elastic_contact_time_of_a_power_law_spring(n):
         assert r.F_peak == pytest.approx(k * x_max, rel=1e-9, abs=0)
     else:
         assert 0 < lag <= C3 * theta_max ** 2
+
+
+def test_the_bench_times_the_impacts_the_library_computes():
+    """fraccontact-bench springpot (docs/fractional_damping.md's cost table)
+    steps the h20 impact in calls of 100 internal steps, as an FMU does, with
+    the default dt_max = 0 among its cases: it must end (a call of 100 steps
+    of dt_max = 0 advanced nothing and never ended), and give the library's
+    figures, the same internal steps in the same order (to the last bit)."""
+    import fraccontact
+    bench = os.environ.get("FRACCONTACT_BENCH", str(ROOT / "build" / "fraccontact-bench"))
+    done = subprocess.run([bench, "springpot", "1e3"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    h20 = json.loads(done.stdout)["h20"]
+    springpot = dict(damper=2, damper_order=0.5, c_alpha=3e5, dt_max=1e-7)
+    assert h20["dashpot"]["F_peak"] == fraccontact.impact(dt_max=1e-7).F_peak
+    assert h20["compressed"]["F_peak"] == fraccontact.impact(**springpot).F_peak
+    assert h20["full"]["F_peak"] == fraccontact.impact(memory=1, **springpot).F_peak
