@@ -166,7 +166,7 @@ MUTANTS = [
     mutant("proxy-gravity", "proxy striker", "the driven scene's proxy striker ignores g",
            STRUCTURAL + "; test_readme::test_the_readme_master_loop_is_the_drop_test with g, bit-exact "
            "drop vs driven (test_fmu_coupling)",
-           (LIFE, "cm->accel = m > 0.0 ? cm->p.g : slope;", "cm->accel = m > 0.0 ? 0.0 : slope;")),
+           (LIFE, "cm->accel = m > 0.0 ? cm->p.g + accel : accel;", "cm->accel = m > 0.0 ? accel : accel;")),
     mutant("proxy-mass", "proxy striker", "the proxy striker's 1/m one ulp high",
            "1 ulp; test_fmu_coupling::test_mass_aware_coupling_with_an_exact_master_is_the_drop_test: bit for bit",
            (LIFE, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
