@@ -47,7 +47,9 @@ FORCE = "F <= c v_max"
 CHECKS = ("finite", "no tension", EPS, "momentum", ENERGY, FORCE, "reference")
 _ENERGY_RUNS = [("c = 1e+07", "hertz"), ("c = 1e+09", "hertz"), ("m = 0.001", "hertz"),
                 ("corner c 1e+09, E_s 1e+06, v0 0.0001, m 1000, dt 0.01", "hertz"),
+                ("corner c 1e+09, E_s 1e+06, v0 0.0001, m 0.001, dt 0.01", "hertz"),
                 ("corner c 1e+09, E_s 1e+06, v0 30, m 0.001, dt 1e-07", "hertz"),
+                ("corner c 1e+09, E_s 1e+06, v0 30, m 0.001, dt 0.01", "hertz"),
                 ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 1e-07", "hertz"),
                 ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 0.01", "hertz"),
                 ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 1000, dt 0.01", "hertz"),
