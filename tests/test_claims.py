@@ -25,7 +25,7 @@ pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
 from fmpy import simulate_fmu
 
 import fraccontact
-from doc_pages import prose, section
+from doc_pages import all_blocks, prose, section
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PROSE = prose()  # every page's sentences, as one line each
@@ -459,7 +459,6 @@ def test_the_defaults_against_the_papers_table_1():
 
 def cosim_commands():
     """The `fraccontact cosim` lines of the guides' shell blocks, without their comments."""
-    from doc_pages import all_blocks
     return [line.split("#")[0].split() for _, _, lang, body in all_blocks() if lang == "sh"
             for line in body.splitlines() if line.startswith("fraccontact cosim ")]
 

@@ -1083,7 +1083,6 @@ def test_the_bench_times_the_impacts_the_library_computes():
     the default dt_max = 0 among its cases: it must end (a call of 100 steps
     of dt_max = 0 advanced nothing and never ended), and give the library's
     figures, the same internal steps in the same order (to the last bit)."""
-    import fraccontact
     bench = os.environ.get("FRACCONTACT_BENCH", str(ROOT / "build" / "fraccontact-bench"))
     done = subprocess.run([bench, "springpot", "1e3"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
