@@ -11,6 +11,8 @@ import pathlib
 from .. import atomic, fmu_path, solver
 from ..options import OneLineParser
 
+BAR = "{l_bar}{bar}| {n}/{total}"  # the reports' progress bars: what is being done, the bar, the count
+
 
 def source_tree():
     """The repository a source-tree report works in (mutation, reliability:

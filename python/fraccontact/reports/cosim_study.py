@@ -13,13 +13,15 @@ Regenerate: scripts/report cosim_study   (about half a minute)
 
 
 import pathlib
+import sys
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import atomic, hertz, impact, model, reports
+from . import BAR
 from ..cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,
                      fmu_paths, monolithic, spring_reference)
-from ..progress import progress
 from ..ssp import run_fmpy, run_libcosim, ssp_path
 
 plt = reports.pyplot()
@@ -118,31 +120,34 @@ def main(argv=None, prog=None):
     ref = monolithic(contact)
     ref_g = monolithic(contact, g=GRAVITY)
     refs_g = {H: gravity_reference(H) for H in STEPS}
-    total, done = (len(RUNS) + len(FORCED)) * len(STEPS), 0
+    bar = tqdm(total=(len(RUNS) + len(FORCED)) * len(STEPS) + 3, file=sys.stderr, disable=None, bar_format=BAR)
     results, forced = {}, {}
     for coupling, order in RUNS:
         rows = []
         for H in STEPS:
-            progress(done, total, f"{coupling}, {order}, H = {H:g}")
+            bar.set_description(f"{coupling}, {order}, H = {H:g}")
             rows.append(errors(run(contact, striker, H, coupling, order), ref, H))
-            done += 1
+            bar.update()
         results[(coupling, order)] = rows
     for label, coupling, order, knows in FORCED:
         rows = []
         for H in STEPS:
-            progress(done, total, f"{label}, H = {H:g}")
+            bar.set_description(f"{label}, H = {H:g}")
             r = run(contact, striker, H, coupling, order, g=GRAVITY, g_contact=GRAVITY if knows else 0.0)
             rows.append(errors(r, refs_g[H], H))
-            done += 1
+            bar.update()
         forced[label] = rows
-    progress(total, total, f"a spring of {SPRING:g} N/m on the striker")
+    bar.set_description(f"a spring of {SPRING:g} N/m on the striker")
     spring = spring_runs(contact, striker)
     traces = {(c, o): cosimulate(contact, striker, 1e-4, c, o, trace=True)["series"]
               for c, o in RUNS if o != "libcosim"}
-    progress(total, total, "the scene as SSP")
+    bar.update()
+    bar.set_description("the scene as SSP")
     scene = ssp_runs(ssp, contact, striker)
+    bar.update()
     g1 = monolithic(contact, law=1)
-    progress(total, total, "done")
+    bar.update()
+    bar.close()
     plot(args.out / "cosimulation.png", results, forced, traces)
     write(args.out / "cosimulation.md", results, forced, ref, ref_g, scene, g1, spring)
     print((args.out / "cosimulation.md").read_text())

@@ -11,13 +11,14 @@ Regenerate: scripts/report error_vs_runtime   (after scripts/setup; it builds)
 import csv
 import math
 import pathlib
+import sys
 import tempfile
 import time
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import atomic, model, reports, solver
-from ..progress import progress
 from ..scipy_contact import solve_drop
 
 plt = reports.pyplot()
@@ -118,41 +119,41 @@ def main(argv=None, prog=None):
     t_grid = np.array(sorted(F_ref)) * GRID
 
     total = len(METHODS) * (len(DTS) + 1) + len(ADAPTIVE_TOLERANCES) + len(SCIPY) * len(TOLERANCES) + 5
-    done = 0
+    bar = tqdm(total=total, file=sys.stderr, disable=None, bar_format=BAR)
     results = {}
     for label, options in METHODS:
         rows = []
         for dt in DTS + [1e-7]:
-            progress(done, total, f"{label}, dt {dt:.3g}")
+            bar.set_description(f"{label}, dt {dt:.3g}")
             r, F = solve_method(args.solver, options, dt, tmp)
             rows.append(dict(dt=dt, cpu=r["cpu_seconds"], steps=r["steps"], **errors(r, F, ref, F_ref)))
-            done += 1
+            bar.update()
         results[label] = rows
     adaptive_rows = []
     for tolerance in ADAPTIVE_TOLERANCES:
-        progress(done, total, f"{ADAPTIVE}, tolerance {tolerance:.0e}")
+        bar.set_description(f"{ADAPTIVE}, tolerance {tolerance:.0e}")
         r, F = solve_method(args.solver, ADAPTIVE_OPTIONS + ["--tolerance", tolerance], ADAPTIVE_DT_MAX, tmp)
         adaptive_rows.append(dict(tolerance=tolerance, cpu=r["cpu_seconds"], steps=r["steps"],
                                   **errors(r, F, ref, F_ref)))
-        done += 1
+        bar.update()
     scipy_rows = {}
     for method in SCIPY:
         scipy_rows[method] = []
         for rtol in TOLERANCES:
-            progress(done, total, f"scipy {method}, rtol {rtol:.0e}")
+            bar.set_description(f"scipy {method}, rtol {rtol:.0e}")
             r = scipy_run(method, rtol, t_grid)
             F = {round(t / GRID): f for t, f in zip(t_grid, r["F_grid"])}
             scipy_rows[method].append(dict(rtol=rtol, cpu=r["cpu_seconds"], steps=r["nfev"], **errors(r, F, ref, F_ref)))
-            done += 1
+            bar.update()
     gsl_rows = []
     for rtol in (1e-6, 1e-8, 1e-10, 1e-12, 1e-13):
-        progress(done, total, f"GSL reference, rtol {rtol:.0e}")
+        bar.set_description(f"GSL reference, rtol {rtol:.0e}")
         r = run(args.solver, "--reference", "--law", "hertz", "--rtol", rtol, "--repeat", 21,
                 "--csv", tmp / "gsl.csv", "--output-interval", GRID)
         gsl_rows.append(dict(rtol=rtol, cpu=r["cpu_seconds"], steps=r["steps"],
                              **errors(r, force_on_grid(tmp / "gsl.csv"), ref, F_ref)))
-        done += 1
-    progress(total, total, "done")
+        bar.update()
+    bar.close()
 
     plot(args.out / "error_vs_runtime.png", results, adaptive_rows, scipy_rows, gsl_rows)
     write_report(args.out / "error_vs_runtime.md", results, adaptive_rows, scipy_rows, gsl_rows, ref)

@@ -36,8 +36,10 @@ import re
 import subprocess
 import sys
 
+from tqdm import tqdm
+
 from .. import atomic, hertz, model, reports, solver
-from ..progress import progress
+from . import BAR
 
 REALS = ["v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k", "c", "dt_max", "g", "gap0"]
 VALUES = {"0": 0.0, "negative": -1.0, "denormal": 5e-324, "huge": 1e300, "NaN": math.nan, "+Inf": math.inf,
@@ -675,11 +677,11 @@ def main(argv=None, prog=None):
     args = reports.parse(parser, argv)
     all_cases = list(cases())
     rows = []
-    for i, (name, c) in enumerate(all_cases):
-        progress(i, len(all_cases), name)
-        r = run_case(args.fmu, c)
-        rows.append((name, c, r, judge(name, c, r, str(args.solver))))
-    progress(len(all_cases), len(all_cases), "done")
+    with tqdm(all_cases, file=sys.stderr, disable=None, bar_format=BAR) as bar:
+        for name, c in bar:
+            bar.set_description(name)
+            r = run_case(args.fmu, c)
+            rows.append((name, c, r, judge(name, c, r, str(args.solver))))
     bad = [(n, c, r, j) for n, c, r, j in rows if j.failures]
     expected, observed = {}, {}
     for _, c, r, _ in rows:

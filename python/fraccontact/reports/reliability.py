@@ -15,9 +15,10 @@ import re
 import subprocess
 import sys
 
+from tqdm import tqdm
+
 from .. import atomic
-from ..progress import progress
-from . import make_folder, source_tree
+from . import BAR, make_folder, source_tree
 
 ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
@@ -166,17 +167,21 @@ def main(argv=None, prog=None):
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "docs")
     args = parser.parse_args(argv)
     make_folder(parser, args.out)
-    progress(0, 4, "soak")
-    s = soak(args.build)
-    progress(1, 4, "valgrind")
-    v = valgrind(args.build)
-    progress(2, 4, f"fuzzing {args.fuzz_seconds} s")
-    f = fuzz(args.fuzz_seconds)
-    progress(3, 4, "hostile input")
-    done = subprocess.run([sys.executable, "-m", "fraccontact", "report", "hostile", "--out", args.out],
-                          capture_output=True, text=True)
+    with tqdm(total=4, file=sys.stderr, disable=None, bar_format=BAR) as bar:
+        bar.set_description("soak")
+        s = soak(args.build)
+        bar.update()
+        bar.set_description("valgrind")
+        v = valgrind(args.build)
+        bar.update()
+        bar.set_description(f"fuzzing {args.fuzz_seconds} s")
+        f = fuzz(args.fuzz_seconds)
+        bar.update()
+        bar.set_description("hostile input")
+        done = subprocess.run([sys.executable, "-m", "fraccontact", "report", "hostile", "--out", args.out],
+                              capture_output=True, text=True)
+        bar.update()
     summary = done.stdout.strip().splitlines()[0] if done.stdout.strip() else "the hostile report failed"
-    progress(4, 4, "done")
     write(args.out / "reliability.md", s, v, f, f"Cases: {summary}.")
     print((args.out / "reliability.md").read_text())
     bad = f["crashed"] or done.returncode != 0 or any(r["errors"] != 0 for r in v) \

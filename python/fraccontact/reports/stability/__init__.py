@@ -46,14 +46,14 @@ def main(argv=None, prog=None):
     study = over(dashpot.CONVERGENCE, args.fast, dashpot.FAST_CONVERGENCE, "convergence: ",
                  lambda name, case: [dashpot.convergence(args.solver, name, case, law) for law in ("hertz", "g1")])
     rows = over(dashpot.matrix(), args.fast, dashpot.FAST, "", lambda name, case: [
-        (name, case, dashpot.check(args.solver, case, law, name)) for law in dashpot.LAWS], done=True)
+        (name, case, dashpot.check(args.solver, case, law, name)) for law in dashpot.LAWS])
     seconds = time.monotonic() - start
     # The springpot: its study, then its matrix, both memories per case.
     sp_start = time.monotonic()
     sp_study = over(springpot.CONVERGENCE, args.fast, springpot.FAST_CONVERGENCE, "springpot convergence: ",
                     lambda name, case: [springpot.convergence(name, case)])
     sp_rows = over(springpot.matrix(), args.fast, springpot.FAST, "springpot: ",
-                   lambda name, case: [(name, case, row) for row in springpot.check(case, name)], done=True)
+                   lambda name, case: [(name, case, row) for row in springpot.check(case, name)])
     sp_seconds = time.monotonic() - sp_start
     head = ["# Stability and accuracy on stiff and extreme cases", "",
             f"Regenerate: `scripts/report stability` ({(seconds + sp_seconds) / 60:.1f} min here). `pytest` runs a "

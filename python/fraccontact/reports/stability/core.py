@@ -7,7 +7,9 @@ import math
 import sys
 
 from ... import model
-from ...progress import progress
+from tqdm import tqdm
+
+from .. import BAR
 
 H20 = model.defaults()
 MAX_STEPS = 4e7  # per run: keeps the matrix to minutes
@@ -55,17 +57,16 @@ def judge(row, known, stale):
     row["unexpected"] += [f"{stale[0]}: {c} {stale[1]}" for c in sorted(known - failed)]
 
 
-def over(items, fast, chosen, what, each, done=False):
+def over(items, fast, chosen, what, each):
     """each(name, case), a list, for the (name, case) items (with fast only
     those named in chosen), with a progress bar saying what and the name;
-    the lists joined. done: end the bar's line."""
+    the lists joined."""
     items = [(n, c) for n, c in items if not fast or n in chosen]
     out = []
-    for i, (name, case) in enumerate(items):
-        progress(i, len(items), what + name)
-        out += each(name, case)
-    if done:
-        progress(len(items), len(items), "done")
+    with tqdm(items, file=sys.stderr, disable=None, bar_format=BAR) as bar:
+        for name, case in bar:
+            bar.set_description(what + name)
+            out += each(name, case)
     return out
 
 
