@@ -27,46 +27,60 @@ def body(**values):
     return Slave(md, folder, start=False, instance_name="body", **values)
 
 
-@pytest.mark.parametrize("k_s, c_s", [(5e4, 300.0),      # underdamped (the panel)
-                                      (5e4, 2 * np.sqrt(5e4 * 0.5)),  # critical
-                                      (5e4, 3e4),         # overdamped
-                                      (0.0, 300.0),       # a damper alone
-                                      (0.0, 0.0)])        # free
-def test_body_steps_its_ode_exactly(k_s, c_s):
-    """Two steps of the body (forces, anchor position, velocity and
-    acceleration held) against scipy's solution of m x'' = F2 - F - k_s (x -
-    x_a(t)) - c_s (v - v_a(t)), x_a(t) = x_a + v_a t + a_a t^2/2; E_diss
-    against the integral of c_s (v - v_a(t))^2."""
-    m, v0, F, F2, x_a, v_a, a_a, H = 0.5, 3.0, 40.0, 15.0, 1e-3, -0.5, 200.0, 2e-3
-    b = body(m=m, k_s=k_s, c_s=c_s, v0=v0)
+@pytest.mark.parametrize("k_s, c_s, m_a", [(5e4, 300.0, 0.0),      # underdamped on the ground (the panel)
+                                           (5e4, 2 * np.sqrt(5e4 * 0.5), 0.0),  # critical
+                                           (5e4, 3e4, 0.0),         # overdamped
+                                           (0.0, 300.0, 0.0),       # a damper alone
+                                           (0.0, 0.0, 0.0),         # free
+                                           (1e6, 7.75e3, 300.0),    # a heavy free anchor (the bumper's vehicle)
+                                           (5e4, 0.0, 2.0),         # a light one, undamped
+                                           (5e4, 3e4, 2.0),         # overdamped
+                                           (0.0, 300.0, 2.0)])      # a damper alone
+def test_body_steps_its_ode_exactly(k_s, c_s, m_a):
+    """Two steps of the body (forces held) against scipy's solution of m x''
+    = F2 - F - k_s (x - x_a) - c_s (v - v_a), with m_a x_a'' = k_s (x - x_a)
+    + c_s (v - v_a) for a free anchor (m_a > 0, starting at v0 too) or x_a =
+    0 on the ground; E_diss against the integral of c_s (v - v_a)^2; the
+    outputs a and a2 against their forces."""
+    m, v0, F, F2, H = 0.5, 3.0, 40.0, 15.0, 2e-3
+    b = body(m=m, k_s=k_s, c_s=c_s, v0=v0, m_a=m_a)
     b.start()
+    v_a0 = v0 if m_a > 0 else 0.0
     assert b.get("mass") == m and b.get("v") == v0 and b.get("x") == 0.0
-    b.set(F=F, F2=F2, x_a=x_a, v_a=v_a, a_a=a_a)
-    # The outputs at the step's start: the accelerations of every force but F, but F2, and of all.
-    own = -(k_s * (0.0 - x_a) + c_s * (v0 - v_a)) / m
-    for name, value in (("a", own + F2 / m), ("a2", own - F / m), ("a_total", own + (F2 - F) / m)):
-        assert b.get(name) == pytest.approx(value, rel=1e-15, abs=1e-12), name   # the same sums, rounding
+    assert b.get("v_a") == v_a0 and b.get("x_a") == 0.0
+    b.set(F=F, F2=F2)
 
     def rhs(t, y):
-        xa, va = x_a + v_a * t + 0.5 * a_a * t * t, v_a + a_a * t
-        return [y[1], (F2 - F - k_s * (y[0] - xa) - c_s * (y[1] - va)) / m, c_s * (y[1] - va) ** 2]
-    ref = solve_ivp(rhs, (0, 2 * H), [0.0, v0, 0.0], method="DOP853", rtol=1e-13, atol=1e-16, dense_output=True)
+        x, v, x_a, v_a, _ = y
+        pull = k_s * (x - x_a) + c_s * (v - v_a)
+        return [v, (F2 - F - pull) / m, v_a, pull / m_a if m_a > 0 else 0.0, c_s * (v - v_a) ** 2]
+    ref = solve_ivp(rhs, (0, 2 * H), [0.0, v0, 0.0, v_a0, 0.0], method="DOP853", rtol=1e-13, atol=1e-16,
+                    dense_output=True)
     for n in (1, 2):
         b.step(H)
-        x, v, E = ref.sol(n * H)
+        x, v, x_a, v_a, E = ref.sol(n * H)
         # The closed form is exact; scipy's DOP853 at rtol 1e-13 and the
         # closed form's cancellation (x of 6e-3 m from terms of the same
-        # size) bound the difference at about 1e-12 relative.
+        # size) bound the difference at about 1e-12 relative; a and a2 take
+        # k_s (x - x_a) from scipy's x - x_a, a difference of near equals:
+        # 4e-9 relative seen.
         assert b.get("x") == pytest.approx(x, rel=1e-10, abs=1e-15)
         assert b.get("v") == pytest.approx(v, rel=1e-10, abs=1e-13)
+        assert b.get("x_a") == pytest.approx(x_a, rel=1e-10, abs=1e-15)
+        assert b.get("v_a") == pytest.approx(v_a, rel=1e-10, abs=1e-13)
         assert b.get("E_diss") == pytest.approx(E, rel=1e-9, abs=1e-12)
+        own = -(k_s * (x - x_a) + c_s * (v - v_a)) / m
+        assert b.get("a") == pytest.approx(own + F2 / m, rel=3e-8, abs=1e-9)
+        assert b.get("a2") == pytest.approx(own - F / m, rel=3e-8, abs=1e-9)
     b.free()
 
 
 def test_body_refuses_bad_values_and_stays_usable():
     b = body()
     for name, value, rule in (("m", 0.0, "mass must be positive"), ("k_s", -1.0, "must not be negative"),
-                              ("c_s", -1.0, "must not be negative"), ("F", float("nan"), "must be finite")):
+                              ("c_s", -1.0, "must not be negative"), ("F", float("nan"), "must be finite"),
+                              ("m_a", -1.0, "the anchor's mass must not be negative (0: the ground)"),
+                              ("m_a", float("inf"), "must be finite")):
         with pytest.raises(Exception):
             b.set(**{name: value})
         assert f"{name} = " in b.recent_error() and rule in b.recent_error()
