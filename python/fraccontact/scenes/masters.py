@@ -30,6 +30,7 @@ from .. import crash, fmu_path
 from ..ssp import bound_parameters
 from . import bumper as bumper_reference
 from . import headform as headform_reference
+from .chain import Contact
 from .parameters import ADULT, CHILD, SPEEDS, Bonnet, Bumper
 from .systems import CLEARANCE, RECORDED, STEP, T_END, VALUES
 
@@ -37,6 +38,8 @@ MASTERS = ("fmpy", "libcosim", "container", "container-gs", "reference")
 HEADFORMS = {"adult": ADULT, "child": CHILD}
 # The reference's tolerance: far below the co-simulations' errors.
 RTOL = 1e-10
+# The contacts' spring: Hertz's (law 2), the exponent the references take.
+HERTZ_N = Contact.n
 
 
 def ssp_path(scene):
@@ -187,7 +190,8 @@ def reference(scene, H, t_end, options=None):
     for i, body in enumerate(bodies):
         trace[body.format("v")], trace[body.format("x")] = s["v"][i], s["u"][i]
     for i, contact in enumerate(contacts):
-        trace[f"{contact}.F"], trace[f"{contact}.E_diss"] = s["F"][i], y[chain.E_CONTACTS][i]
+        trace[f"{contact}.F"], trace[f"{contact}.x1"], trace[f"{contact}.E_diss"] = (s["F"][i], s["x1"][i],
+                                                                                     y[chain.E_CONTACTS][i])
     trace[f"{link_holder}.E_diss"] = y[chain.E_LINKS]
     trace["events"] = run_.events
     return trace
@@ -213,37 +217,58 @@ def contact_duration(trace, contact):
     return float(t[min(on[-1] + 1, len(t) - 1)] - t[max(on[0] - 1, 0)])
 
 
+def stored(trace, contact, k):
+    """The energy in a contact's Hertz spring, k x1^(n+1)/(n+1) [J]."""
+    return k * np.maximum(trace[f"{contact}.x1"], 0.0) ** (HERTZ_N + 1) / (HERTZ_N + 1)
+
+
+def balance(trace, scene, start):
+    """The energy over the run, kinetic + springs (the bodies' and the
+    contacts') + dissipated, over the impact energy, less 1 (> 0: energy
+    created)."""
+    if scene == "headform":
+        head, panel = start["head"], start["panel"]
+        E0 = 0.5 * head["m"] * head["v0"] ** 2
+        energy = (0.5 * head["m"] * trace["head.v"] ** 2 + 0.5 * panel["m"] * trace["panel.v"] ** 2
+                  + 0.5 * panel["k_s"] * trace["panel.x"] ** 2 + stored(trace, "skin", start["skin"]["k"])
+                  + stored(trace, "hard", start["hard"]["k"])
+                  + trace["skin.E_diss"] + trace["hard.E_diss"] + trace["panel.E_diss"])
+        return energy / E0 - 1
+    vehicle = start["vehicle"]
+    M, m, v = vehicle["m_a"], vehicle["m"], vehicle["v0"]
+    energy = (0.5 * M * trace["vehicle.v_a"] ** 2 + 0.5 * m * trace["vehicle.v"] ** 2
+              + 0.5 * vehicle["k_s"] * (trace["vehicle.x_a"] - trace["vehicle.x"]) ** 2
+              + stored(trace, "fascia", start["fascia"]["k"]) + trace["fascia.E_diss"] + trace["vehicle.E_diss"])
+    return energy / (0.5 * (M + m) * v * v) - 1
+
+
 def figures(trace, scene, options=None):
     """The crash figures of a trace. headform: the head's HIC15 (CFC 1000,
     crash.figures) with its window, peak g, 3 ms clip, the panel's
     deflection, the head's travel, the skin contact's duration, the head's
-    restitution (-v_end/v0), energy_error. bumper: F_peak, crush (the
-    vehicle's travel), the vehicle's peak g, the fascia's duration, the
-    system's restitution (-momentum at the end / (M + m_b) v), energy_error
-    and momentum_error (the momentum lost against the barrier's impulse)."""
+    restitution (-v_end/v0). bumper: F_peak, crush (the vehicle's travel),
+    the vehicle's peak g, the fascia's duration, the system's restitution
+    (-momentum at the end / (M + m_b) v), momentum_error (the momentum lost
+    against the barrier's impulse). Both: energy_error, the balance at the
+    end; energy_first, after the first step; energy_max, its largest from the
+    second step on."""
     start = values(scene, options)
+    energy = balance(trace, scene, start)
+    energies = dict(energy_error=float(energy[-1]), energy_first=float(energy[1]), energy_max=float(energy[2:].max()))
     if scene == "headform":
-        head, panel = start["head"], start["panel"]
+        head = start["head"]
         f = crash.figures(*deceleration(trace, "head"))
-        E0 = 0.5 * head["m"] * head["v0"] ** 2
-        energy = (0.5 * head["m"] * trace["head.v"] ** 2 + 0.5 * panel["m"] * trace["panel.v"] ** 2
-                  + 0.5 * panel["k_s"] * trace["panel.x"] ** 2
-                  + trace["skin.E_diss"] + trace["hard.E_diss"] + trace["panel.E_diss"])
         return dict(HIC15=f["HIC15"], HIC15_window=f["HIC15_window"], peak_g=f["peak_g"], clip3ms_g=f["clip3ms_g"],
                     panel_deflection=float(trace["panel.x"].max()), head_travel=float(trace["head.x"].max()),
                     duration=contact_duration(trace, "skin"), restitution=float(-trace["head.v"][-1] / head["v0"]),
-                    energy_error=float(energy[-1] / E0 - 1))
+                    **energies)
     vehicle = start["vehicle"]
     M, m, v = vehicle["m_a"], vehicle["m"], vehicle["v0"]
     _, a = deceleration(trace, "vehicle", "v_a")
     t, F = trace["t"], trace["fascia.F"]
     p = M * trace["vehicle.v_a"] + m * trace["vehicle.v"]
     impulse = np.concatenate([[0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t))])
-    energy = (0.5 * M * trace["vehicle.v_a"] ** 2 + 0.5 * m * trace["vehicle.v"] ** 2
-              + 0.5 * vehicle["k_s"] * (trace["vehicle.x_a"] - trace["vehicle.x"]) ** 2
-              + trace["fascia.E_diss"] + trace["vehicle.E_diss"])
     return dict(F_peak=float(F.max()), crush=float(trace["vehicle.x_a"].max()),
                 peak_g=float(np.max(np.abs(a)) / crash.STANDARD_GRAVITY),
                 duration=contact_duration(trace, "fascia"), restitution=float(-p[-1] / ((M + m) * v)),
-                energy_error=float(energy[-1] / (0.5 * (M + m) * v * v) - 1),
-                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)))
+                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)), **energies)

@@ -38,12 +38,12 @@ FMUS = {"head": "body", "panel": "body", "skin": "fraccontact", "hard": "fraccon
         "vehicle": "body", "fascia": "fraccontact"}
 # What each scene's co-simulation records: the bodies' velocities and
 # positions (the bumper's beam: vehicle.v, vehicle.x; the vehicle's body, the
-# beam's anchor: vehicle.v_a, vehicle.x_a), the contacts' force, the work the
-# contacts and dampers dissipate.
-RECORDED = {"headform": ("head.v", "head.x", "panel.v", "panel.x", "skin.F", "hard.F", "skin.E_diss", "hard.E_diss",
-                         "panel.E_diss"),
-            "bumper": ("vehicle.v_a", "vehicle.x_a", "vehicle.v", "vehicle.x", "fascia.F", "fascia.E_diss",
-                       "vehicle.E_diss")}
+# beam's anchor: vehicle.v_a, vehicle.x_a), the contacts' force and spring
+# deflection x1, the work the contacts and dampers dissipate.
+RECORDED = {"headform": ("head.v", "head.x", "panel.v", "panel.x", "skin.F", "hard.F", "skin.x1", "hard.x1",
+                         "skin.E_diss", "hard.E_diss", "panel.E_diss"),
+            "bumper": ("vehicle.v_a", "vehicle.x_a", "vehicle.v", "vehicle.x", "fascia.F", "fascia.x1",
+                       "fascia.E_diss", "vehicle.E_diss")}
 # The communication step the SSDs carry and the docs recommend, and the
 # simulated time: the head has left the panel, the fascia the barrier.
 STEP = {"headform": 1e-5, "bumper": 1e-5}
