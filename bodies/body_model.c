@@ -268,7 +268,7 @@ static void relative_step(double beta, double w2, double g, double H, double y, 
 fm_status fm_do_step(fmu_model *fm, double t, double H)
 {
     const double f = fm->F2 - fm->F, g = f / fm->m;
-    const double total = fm->m + fm->m_a, mu = fm->m_a > 0.0 ? fm->m * fm->m_a / total : fm->m;
+    const double total = fm->m + fm->m_a, mu = fm->m_a > 0.0 ? fm->m / (1.0 + fm->m / fm->m_a) : fm->m;
     const double y = fm->x - fm->x_a, y_rate = fm->v - fm->v_a;
     double y_end, y_rate_end;
     relative_step(0.5 * fm->c_s / mu, fm->k_s / mu, g, H, y, y_rate, &y_end, &y_rate_end);
