@@ -182,7 +182,7 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_con
         "**Recommended step: H = 1e-5 s** (the SSDs' step). The masters run the SSPs as they are, with "
         "these differences:",
         "",
-        "- fmpy's `simulate_ssp` (fmpy/ssp/simulation.py) starts every connector at 0, sets every input from "
+        "- fmpy's `simulate_ssp` (its module fmpy.ssp.simulation) starts every connector at 0, sets every input from "
         "its connector before each step (a start value, even one of its parameter set, does not outlive the "
         "first step) and reads no SSV binding (fraccontact.ssp passes the bindings as its parameter set): the "
         "contacts see no motion in the first step, in which every body flies free. With every spring and damper "
@@ -196,7 +196,7 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_con
         "- container-gs: the toolbox's sequential mode (`Assembly(sequential=True)`, `-sequential` on its "
         "command line), in which, its source says, the FMUs \"step one after the other in the order of the "
         "configuration, each one with the outputs just computed by the previous ones\" "
-        "(container/builder.py, check_sequential_order): Gauss-Seidel. The runner puts the contacts first, "
+        "(fmu_manipulation_toolbox.container.builder, check_sequential_order): Gauss-Seidel. The runner puts the contacts first, "
         "sets their coupling = 1 and feeds the bodies F_avg in place of the SSD's F_avg_next "
         "(fraccontact.scenes.container.gauss_seidel; docs/coupling.md).",
         "",
