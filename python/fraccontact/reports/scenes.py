@@ -196,8 +196,8 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_con
         "- container-gs: the toolbox's sequential mode (`Assembly(sequential=True)`, `-sequential` on its "
         "command line), in which, its source says, the FMUs \"step one after the other in the order of the "
         "configuration, each one with the outputs just computed by the previous ones\" "
-        "(fmu_manipulation_toolbox.container.builder, check_sequential_order): Gauss-Seidel. The runner puts the contacts first, "
-        "sets their coupling = 1 and feeds the bodies F_avg in place of the SSD's F_avg_next "
+        "(fmu_manipulation_toolbox.container.builder, check_sequential_order): Gauss-Seidel. The runner puts "
+        "the contacts first, sets their coupling = 1 and feeds the bodies F_avg in place of the SSD's F_avg_next "
         "(fraccontact.scenes.container.gauss_seidel; docs/coupling.md).",
         "",
         "## Headform on a bonnet: masters side by side",
