@@ -2,20 +2,21 @@
  * by a spring k_s and a damper c_s in parallel (unstretched at the start),
  * pushed by two contact forces: F against its motion (the contact in which
  * it is the striker: -F) and F2 along it (the contact in which it is the
- * second body: +F). The anchor is the ground (x_a = v_a = a_a = 0, the defaults)
- * or another body, whose position, velocity and acceleration the master
- * connects to x_a, v_a and a_a. Outputs: its position x and velocity v (from where it starts,
- * towards the impact), its mass, and the accelerations a contact's proxy
- * needs to move as the body does: a, of every force but F (the spring, the
- * damper and F2), for the contact it strikes (that contact's input a), and
- * a2, of every force but F2, for the contact that strikes it (its a2); and
- * a_total, of every force (another body's anchor acceleration a_a); E_diss,
- * the work its damper has dissipated.
+ * second body: +F). The anchor is the ground (m_a = 0, the default) or a free
+ * mass m_a inside this FMU (a vehicle behind its bumper beam, the crash box
+ * between them), starting at the body's v0: a stiff element is never split
+ * across FMUs, the contacts are the only coupling between them. Outputs: the
+ * body's position x and velocity v (from where it starts, towards the
+ * impact), the anchor's x_a and v_a, its mass, and the accelerations a
+ * contact's proxy needs to move as the body does: a, of every force but F
+ * (the spring, the damper and F2), for the contact it strikes (that
+ * contact's input a), and a2, of every force but F2, for the contact that
+ * strikes it (its a2); E_diss, the work its damper has dissipated.
  *
- * Over a step the forces are held and the anchor moves at the constant
- * acceleration a_a; the relative motion y = x - x_a then obeys
- * y'' + (c_s/m) y' + (k_s/m) y = (F2 - F)/m - a_a, integrated exactly (a
- * damped oscillator, whatever its damping). */
+ * Over a step the forces are held. The relative motion y = x - x_a then
+ * obeys mu y'' + c_s y' + k_s y = mu f/m with f = F2 - F and mu = m m_a/(m +
+ * m_a) (mu = m on the ground), a damped oscillator integrated exactly, and
+ * the centre of mass moves at the constant acceleration f/(m + m_a). */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -26,16 +27,14 @@
 
 enum {
     VR_F = 1, VR_F2 = 2, VR_x_a = 3, VR_v_a = 4, VR_m = 5, VR_k_s = 6, VR_c_s = 7, VR_v0 = 8,
-    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14,
-    VR_a_a = 15, VR_a_total = 16
+    VR_x = 9, VR_v = 10, VR_a = 11, VR_a2 = 12, VR_mass = 13, VR_E_diss = 14, VR_m_a = 15
 };
 
 struct fmu_model {
-    double F, F2, x_a, v_a, a_a; /* inputs */
-    double m, k_s, c_s, v0; /* parameters */
-    double x, v, a, a2, a_total, mass, E_diss; /* outputs */
+    double F, F2; /* inputs */
+    double m, k_s, c_s, v0, m_a; /* parameters */
+    double x, v, x_a, v_a, a, a2, mass, E_diss; /* outputs (x, v, x_a, v_a, E_diss: the state) */
     double t;
-    double anchor, anchor_v; /* the anchor's position and velocity now: x_a, v_a as last set, moved on at a_a since */
     int started;
     fmu_reporter log;
 };
@@ -43,9 +42,8 @@ struct fmu_model {
 static const fmu_variable variable_list[] = {
     {VR_F, "F", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F)},
     {VR_F2, "F2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, F2)},
-    {VR_x_a, "x_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, x_a)},
-    {VR_v_a, "v_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, v_a)},
-    {VR_a_a, "a_a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, a_a)},
+    {VR_x_a, "x_a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, x_a)},
+    {VR_v_a, "v_a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v_a)},
     {VR_m, "m", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, m)},
     {VR_k_s, "k_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, k_s)},
     {VR_c_s, "c_s", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, c_s)},
@@ -54,9 +52,9 @@ static const fmu_variable variable_list[] = {
     {VR_v, "v", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, v)},
     {VR_a, "a", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a)},
     {VR_a2, "a2", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a2)},
-    {VR_a_total, "a_total", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, a_total)},
     {VR_mass, "mass", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, mass)},
     {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, offsetof(fmu_model, E_diss)},
+    {VR_m_a, "m_a", VAR_REAL, VAR_PARAMETER, offsetof(fmu_model, m_a)},
 };
 
 static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
@@ -64,7 +62,7 @@ static const fmu_variables variables = {variable_list, sizeof variable_list / si
 /* The spring's and damper's acceleration of the body now. */
 static double own_acceleration(const fmu_model *fm)
 {
-    return -(fm->k_s * (fm->x - fm->anchor) + fm->c_s * (fm->v - fm->anchor_v)) / fm->m;
+    return -(fm->k_s * (fm->x - fm->x_a) + fm->c_s * (fm->v - fm->v_a)) / fm->m;
 }
 
 /* The outputs that follow from the state and the inputs. */
@@ -73,8 +71,16 @@ static void update_outputs(fmu_model *fm)
     const double own = own_acceleration(fm);
     fm->a = own + fm->F2 / fm->m;
     fm->a2 = own - fm->F / fm->m;
-    fm->a_total = own + (fm->F2 - fm->F) / fm->m;
     fm->mass = fm->m;
+}
+
+/* The state at the start: the body at v0, a free anchor with it, the ground at rest. */
+static void start_state(fmu_model *fm)
+{
+    fm->x = fm->x_a = 0.0;
+    fm->v = fm->v0;
+    fm->v_a = fm->m_a > 0.0 ? fm->v0 : 0.0;
+    fm->E_diss = 0.0;
 }
 
 fmu_model *fm_new(fm_report report, void *env)
@@ -113,6 +119,8 @@ static const char *rule_broken(unsigned vr, double value)
         return "the spring's stiffness must not be negative [N/m]";
     if (vr == VR_c_s && value < 0.0)
         return "the damper's constant must not be negative [N s/m]";
+    if (vr == VR_m_a && value < 0.0)
+        return "the anchor's mass must not be negative (0: the ground) [kg]";
     return NULL;
 }
 
@@ -126,12 +134,8 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
     if (why)
         return fmu_say(&fm->log, FM_ERROR, "logStatusError", "%s = %g is invalid: %s", var->name, value, why);
     *(double *)((char *)fm + var->offset) = value;
-    if (vr == VR_x_a)
-        fm->anchor = value;
-    if (vr == VR_v_a)
-        fm->anchor_v = value;
     if (!fm->started) /* before initialization the outputs show the start */
-        fm->v = fm->v0;
+        start_state(fm);
     update_outputs(fm);
     return FM_OK;
 }
@@ -191,20 +195,23 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
         return FM_OK;
     }
     if (order == 1 && vr == VR_v) {
-        *value = fm->a_total;
+        *value = own_acceleration(fm) + (fm->F2 - fm->F) / fm->m;
+        return FM_OK;
+    }
+    if (order == 1 && vr == VR_x_a) {
+        *value = fm->v_a;
         return FM_OK;
     }
     return fmu_say(&fm->log, FM_ERROR, "logStatusError",
-                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x and v, order 1", vr, order);
+                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x, v and x_a, order 1", vr,
+                   order);
 }
 
 fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
     (void)t_stop;
     fm->t = t0;
-    fm->x = 0.0;
-    fm->v = fm->v0;
-    fm->E_diss = 0.0;
+    start_state(fm);
     fm->started = 1;
     update_outputs(fm);
     return FM_OK;
@@ -236,34 +243,50 @@ static void damped(double beta, double w2, double t, double *eC, double *eS)
     }
 }
 
-/* The body over [t, t + H], forces held, the anchor moving at the acceleration a_a. */
-fm_status fm_do_step(fmu_model *fm, double t, double H)
+/* The relative motion y = x - x_a over a step from (y, y_rate), forcing g
+ * held: y'' + 2 beta y' + w2 y = g, exactly. */
+static void relative_step(double beta, double w2, double g, double H, double y, double y_rate, double *y_end,
+                          double *y_rate_end)
 {
-    const double f = (fm->F2 - fm->F) / fm->m - fm->a_a, beta = 0.5 * fm->c_s / fm->m, w2 = fm->k_s / fm->m;
-    const double y = fm->x - fm->anchor, y_rate = fm->v - fm->anchor_v;
-    double y_end, y_rate_end;
-    if (w2 > 0.0) { /* about the equilibrium f/w2 */
-        const double z = y - f / w2;
+    if (w2 > 0.0) { /* about the equilibrium g/w2 */
+        const double z = y - g / w2;
         double eC, eS;
         damped(beta, w2, H, &eC, &eS);
-        y_end = f / w2 + z * eC + (y_rate + beta * z) * eS;
-        y_rate_end = y_rate * eC - (w2 * z + beta * y_rate) * eS;
-    } else if (beta > 0.0) { /* a damper alone: the rate relaxes to the terminal f/(2 beta) */
-        const double terminal = f / (2.0 * beta), decay = -expm1(-2.0 * beta * H);
-        y_end = y + terminal * H + (y_rate - terminal) * decay / (2.0 * beta);
-        y_rate_end = terminal + (y_rate - terminal) * (1.0 - decay);
+        *y_end = g / w2 + z * eC + (y_rate + beta * z) * eS;
+        *y_rate_end = y_rate * eC - (w2 * z + beta * y_rate) * eS;
+    } else if (beta > 0.0) { /* a damper alone: the rate relaxes to the terminal g/(2 beta) */
+        const double terminal = g / (2.0 * beta), decay = -expm1(-2.0 * beta * H);
+        *y_end = y + terminal * H + (y_rate - terminal) * decay / (2.0 * beta);
+        *y_rate_end = terminal + (y_rate - terminal) * (1.0 - decay);
     } else {
-        y_end = y + H * (y_rate + 0.5 * H * f);
-        y_rate_end = y_rate + H * f;
+        *y_end = y + H * (y_rate + 0.5 * H * g);
+        *y_rate_end = y_rate + H * g;
     }
-    /* In the frame of the anchor m y'' y' = m f y' - k_s y y' - c_s y'^2 (f with the frame's force -m a_a):
-     * the damper's work over the step is exact from the step's ends. */
-    fm->E_diss += fm->m * f * (y_end - y)
-                  - 0.5 * fm->m * (y_rate_end * y_rate_end - y_rate * y_rate) - 0.5 * fm->k_s * (y_end * y_end - y * y);
-    fm->anchor += H * (fm->anchor_v + 0.5 * H * fm->a_a);
-    fm->anchor_v += H * fm->a_a;
-    fm->x = fm->anchor + y_end;
-    fm->v = fm->anchor_v + y_rate_end;
+}
+
+/* The body and its anchor over [t, t + H], the contact forces held. */
+fm_status fm_do_step(fmu_model *fm, double t, double H)
+{
+    const double f = fm->F2 - fm->F, g = f / fm->m;
+    const double total = fm->m + fm->m_a, mu = fm->m_a > 0.0 ? fm->m / (1.0 + fm->m / fm->m_a) : fm->m;
+    const double y = fm->x - fm->x_a, y_rate = fm->v - fm->v_a;
+    double y_end, y_rate_end;
+    relative_step(0.5 * fm->c_s / mu, fm->k_s / mu, g, H, y, y_rate, &y_end, &y_rate_end);
+    /* mu y'' y' = mu g y' - k_s y y' - c_s y'^2: the damper's work over the step is exact from the step's ends. */
+    fm->E_diss += mu * g * (y_end - y) - 0.5 * mu * (y_rate_end * y_rate_end - y_rate * y_rate)
+                  - 0.5 * fm->k_s * (y_end * y_end - y * y);
+    if (fm->m_a > 0.0) { /* the centre of mass at f/(m + m_a), each mass about it */
+        const double centre_v0 = (fm->m * fm->v + fm->m_a * fm->v_a) / total;
+        const double centre = (fm->m * fm->x + fm->m_a * fm->x_a) / total + H * (centre_v0 + 0.5 * H * f / total);
+        const double centre_v = centre_v0 + H * f / total;
+        fm->x = centre + fm->m_a / total * y_end;
+        fm->v = centre_v + fm->m_a / total * y_rate_end;
+        fm->x_a = centre - fm->m / total * y_end;
+        fm->v_a = centre_v - fm->m / total * y_rate_end;
+    } else {
+        fm->x = y_end;
+        fm->v = y_rate_end;
+    }
     fm->t = t + H;
     update_outputs(fm);
     return FM_OK;
@@ -276,8 +299,8 @@ double fm_time(const fmu_model *fm)
 
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
-static const state_field state_fields[] = {F(F), F(F2), F(x_a), F(v_a), F(a_a), F(anchor_v), F(m), F(k_s), F(c_s),
-                                           F(v0), F(x),  F(v),   F(t),    F(anchor), F(E_diss),
+static const state_field state_fields[] = {F(F),  F(F2), F(m),   F(k_s), F(c_s),    F(v0), F(m_a),
+                                           F(x),  F(v),  F(x_a), F(v_a), F(E_diss), F(t),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
 #define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
@@ -300,7 +323,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
     fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
-        || rule_broken(VR_k_s, trial.k_s) || rule_broken(VR_c_s, trial.c_s)
+        || rule_broken(VR_k_s, trial.k_s) || rule_broken(VR_c_s, trial.c_s) || rule_broken(VR_m_a, trial.m_a)
         || (trial.started != 0 && trial.started != 1))
         return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
     *fm = trial;

@@ -1,21 +1,25 @@
 # build/headform.ssp and build/bumper.ssp: the crash scenes (issue 25) as SSP
 # 1.0, their SSD from ssp/ and their SSV files written from
 # fraccontact/scenes/parameters.py by fraccontact.scenes.systems, with the
-# FMUs of this build. (Not in the Python package: it ships drop_test.ssp.)
+# FMUs of this build; the Python package ships them (SCENE_SSP_FILES).
 set(scene_ssvs "${CMAKE_BINARY_DIR}/scenes_ssv")
 file(GLOB scene_python "${CMAKE_SOURCE_DIR}/python/fraccontact/scenes/*.py")
 add_custom_command(OUTPUT "${scene_ssvs}/stamp"
   COMMAND "${CMAKE_COMMAND}" -E rm -rf "${scene_ssvs}"
-  COMMAND "${CMAKE_COMMAND}" -E env "PYTHONPATH=${CMAKE_SOURCE_DIR}/python"
-          "FRACCONTACT_LIBRARY=$<TARGET_FILE:fraccontact_shared>" ${PYTHON_SANITIZER_ENV}
+  # python -m finds the package in its working folder, first; PYTHONPATH is left as it is (pip's build
+  # environment lives on it).
+  COMMAND "${CMAKE_COMMAND}" -E env "FRACCONTACT_LIBRARY=$<TARGET_FILE:fraccontact_shared>" ${PYTHON_SANITIZER_ENV}
           "${Python3_EXECUTABLE}" -m fraccontact.scenes.systems "${scene_ssvs}"
   COMMAND "${CMAKE_COMMAND}" -E touch "${scene_ssvs}/stamp"
+  WORKING_DIRECTORY "${CMAKE_SOURCE_DIR}/python"
   DEPENDS ${scene_python} fraccontact_shared
   COMMENT "Writing the scenes' SSV files")
 # One target runs it: two targets depending on one custom command's output would run it twice, at once.
 add_custom_target(scene_ssvs DEPENDS "${scene_ssvs}/stamp")
+set(SCENE_SSP_FILES "")
 foreach(scene headform bumper)
   set(ssp_file "${CMAKE_BINARY_DIR}/${scene}.ssp")
+  list(APPEND SCENE_SSP_FILES "${ssp_file}")
   set(staging "${CMAKE_BINARY_DIR}/${scene}.ssp.d")
   add_custom_command(OUTPUT "${ssp_file}"
     COMMAND "${CMAKE_COMMAND}" -E rm -rf "${staging}"

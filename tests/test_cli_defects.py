@@ -27,6 +27,7 @@ if os.environ.get("FRACCONTACT_SANITIZED") == "1":
 import fraccontact  # noqa: E402
 from fraccontact import cli, cosim, fit, ssp  # noqa: E402
 from fraccontact.reports import calibration, h20_drop, stability  # noqa: E402
+from fraccontact.scenes import masters  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
@@ -298,26 +299,34 @@ def test_every_command_has_an_extra():
 
 
 def test_the_package_ships_the_scene_its_reports_run():
-    """pip install . builds with FRACCONTACT_PACKAGE: the SSP is made and
-    installed into the package beside the FMUs, where ssp_path() looks."""
+    """pip install . builds with FRACCONTACT_PACKAGE: the SSPs (the drop
+    test, the crash scenes) are made and installed into the package beside
+    the FMUs, where ssp_path() and scenes.masters.ssp_path() look (scripts/test
+    installs the package and runs the scenes)."""
     cmake = (ROOT / "CMakeLists.txt").read_text()
     package = re.search(r"if\(FRACCONTACT_PACKAGE\)\n(.*?)\n  return\(\)", cmake, re.S).group(1)
-    assert "add_subdirectory(ssp)" in package
-    installed = re.search(r'install\(FILES (.*?) DESTINATION fraccontact\)', package).group(1)
-    assert "${SSP_FILE}" in installed and "${FMU_FILE}" in installed
+    assert "add_subdirectory(ssp)" in package and "include(ssp/scenes.cmake)" in package
+    installed = re.search(r'install\(FILES (.*?) DESTINATION fraccontact\)', package, re.S).group(1)
+    for name in ("${SSP_FILE}", "${FMU_FILE}", "body.fmu", "${SCENE_SSP_FILES}"):
+        assert name in installed, name
     ssp_cmake = (ROOT / "ssp" / "CMakeLists.txt").read_text()
     assert 'set(SSP_FILE "${CMAKE_BINARY_DIR}/drop_test.ssp" PARENT_SCOPE)' in ssp_cmake
+    scenes_cmake = (ROOT / "ssp" / "scenes.cmake").read_text()
+    assert "foreach(scene headform bumper)" in scenes_cmake
+    assert 'list(APPEND SCENE_SSP_FILES "${ssp_file}")' in scenes_cmake
     assert PYPROJECT["tool"]["scikit-build"]["wheel"]["packages"] == ["python/fraccontact"]
 
 
 def test_the_scene_is_found_beside_the_installed_fmus(monkeypatch, tmp_path):
     """An installed package: no environment variables, the FMUs and the scene in the package's folder."""
-    for name in ("fraccontact.fmu", "drop_test.ssp"):
+    for name in ("fraccontact.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"):
         (tmp_path / name).write_bytes(b"")
     monkeypatch.setattr(fraccontact, "_HERE", tmp_path)
     for variable in ("FRACCONTACT_FMU", "DROP_TEST_SSP"):
         monkeypatch.delenv(variable, raising=False)
     assert ssp.ssp_path() == tmp_path / "drop_test.ssp"
+    for scene in ("headform", "bumper"):
+        assert masters.ssp_path(scene) == tmp_path / f"{scene}.ssp"
 
 
 # Item 20: a closed pipe; the usage line.

@@ -1,6 +1,7 @@
 """The crash scenes as co-simulations (issue 25): build/headform.ssp and
 build/bumper.ssp in fmpy's SSP master, libcosim and a container FMU
-(fmu-manipulation-toolbox) against their monolithic reference
+(fmu-manipulation-toolbox, in its parallel and its sequential mode) against
+their monolithic reference
 (fraccontact.scenes.chain, scipy), the convergence in H, the HIC15 against
 the clearance, and the figures beside the published ones. Writes
 docs/scenes.md, docs/scenes_hic_clearance.png and docs/scenes_head.png
@@ -17,14 +18,15 @@ from .. import atomic, crash, reports
 from ..scenes import headform, masters, systems
 from ..scenes.parameters import ADULT, CHILD, HIC_LIMITS, SPEEDS
 
-MASTERS = ("fmpy", "libcosim", "container")
+MASTERS = ("fmpy", "libcosim", "container", "container-gs")
 STEPS = (4e-5, 2e-5, 1e-5, 5e-6)
 CLEARANCES = np.arange(0.040, 0.0801, 0.0025)
+ENERGY_FIGURES = (("energy_error", "{:.2e}"), ("energy_first", "{:.2e}"), ("energy_max", "{:.2e}"))
 HEADFORM_FIGURES = (("HIC15", "{:.1f}"), ("peak_g", "{:.2f}"), ("clip3ms_g", "{:.2f}"),
                     ("panel_deflection", "{:.5f}"), ("duration", "{:.5f}"), ("restitution", "{:.5f}"),
-                    ("energy_error", "{:.2e}"))
+                    *ENERGY_FIGURES)
 BUMPER_FIGURES = (("F_peak", "{:.1f}"), ("crush", "{:.6f}"), ("peak_g", "{:.4f}"), ("duration", "{:.5f}"),
-                  ("restitution", "{:.6f}"), ("energy_error", "{:.2e}"), ("momentum_error", "{:.2e}"))
+                  ("restitution", "{:.6f}"), *ENERGY_FIGURES, ("momentum_error", "{:.2e}"))
 
 
 def side_by_side(scene, rows, options=None):
@@ -36,22 +38,22 @@ def side_by_side(scene, rows, options=None):
         cells = []
         for m in MASTERS:
             value = runs[m][name]
-            error = "" if name.endswith("_error") else f" ({value / ref[name] - 1:+.1e})"
+            error = "" if name.startswith("energy") or name.endswith("_error") else f" ({value / ref[name] - 1:+.1e})"
             cells.append(fmt.format(value) + error)
         out.append(f"| {name} | {fmt.format(ref[name])} | " + " | ".join(cells) + " |")
     return out, ref, runs
 
 
 def convergence(scene, names, bar):
-    """Rows of the errors against H (libcosim and fmpy, against the reference on each grid)."""
-    out = ["| H [s] | master | " + " | ".join(f"{n} error" for n in names) + " | energy_error |",
-           "|---|---|" + "---|" * (len(names) + 1)]
+    """Rows of the errors against H (every master, against the reference on each grid)."""
+    out = ["| H [s] | master | " + " | ".join(f"{n} error" for n in names) + " | energy_error | energy_max |",
+           "|---|---|" + "---|" * (len(names) + 2)]
     for H in STEPS:
         ref = masters.figures(masters.run(scene, "reference", H=H), scene)
-        for m in ("libcosim", "fmpy"):
+        for m in MASTERS:
             f = masters.figures(masters.run(scene, m, H=H), scene)
             out.append(f"| {H:g} | {m} | " + " | ".join(f"{f[n] / ref[n] - 1:+.2e}" for n in names)
-                       + f" | {f['energy_error']:+.2e} |")
+                       + f" | {f['energy_error']:+.2e} | {f['energy_max']:+.2e} |")
             bar.update()
     return out
 
@@ -106,7 +108,7 @@ def main(argv=None, prog=None):
     args = p.parse_args(argv)
     reports.make_folder(p, args.out)
     out = args.out
-    with tqdm(total=2 * len(STEPS) * 2 + 2 * len(CLEARANCES), desc="scenes", unit="run") as bar:
+    with tqdm(total=2 * len(STEPS) * len(MASTERS) + 2 * len(CLEARANCES), desc="scenes", unit="run") as bar:
         head_rows, head_ref, _ = side_by_side("headform", HEADFORM_FIGURES)
         traces = {m: masters.run("headform", m) for m in MASTERS}
         plot_head(masters.run("headform", "reference"), traces, out / "scenes_head.png")
@@ -115,7 +117,7 @@ def main(argv=None, prog=None):
         bumper_conv = convergence("bumper", ("F_peak", "crush", "restitution"), bar)
         curves = hic_against_clearance(bar)
     plot_hic(curves, out / "scenes_hic_clearance.png")
-    text = document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_conv, curves)
+    text = document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_conv, bumper_conv, curves)
     atomic.write_text(out / "scenes.md", "\n".join(text) + "\n")
     print(f"wrote {out / 'scenes.md'}")
     return 0
@@ -130,8 +132,9 @@ def crossing(gaps, hic, limit):
     return float("nan")
 
 
-def document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_conv, curves):
+def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_conv, bumper_conv, curves):
     k = systems.CLEARANCE
+    loan = bumper_runs["libcosim"]["energy_first"]
     adult, child = curves["adult"], curves["child"]
     published = [
         "| figure | this model | published |", "|---|---|---|",
@@ -161,30 +164,41 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_con
         "## The scenes as SSPs",
         "",
         "`build/headform.ssp` (ssp/headform.ssd): the headform and the bonnet panel are `body.fmu` (bodies/: "
-        "a mass held to an anchor by a spring k_s and damper c_s, two contact forces in), the skin and the hard "
-        "point two instances of `fraccontact.fmu`. `build/bumper.ssp` (ssp/bumper.ssd): the vehicle and the beam "
-        "are `body.fmu`, each the other's anchor (the crash box), the fascia a `fraccontact.fmu` against the "
-        "rigid barrier (its m2 = 0, v2 = 0). The SSV files are written at build time from "
+        "a mass m held by a spring k_s and a damper c_s to an anchor, the ground or a free mass m_a inside the "
+        "same FMU, two contact forces in), the skin and the hard point two instances of `fraccontact.fmu`. "
+        "`build/bumper.ssp` (ssp/bumper.ssd): the vehicle is one `body.fmu`, its bumper beam the body (m) and "
+        "the vehicle's body its free anchor (m_a) behind the crash box (k_s, c_s), both integrated together "
+        "exactly; the fascia is a `fraccontact.fmu` against the rigid barrier (its m2 = 0, v2 = 0). No spring "
+        "or damper is split across FMUs: the contacts are the only coupling between them. The SSV files are "
+        "written at build time from "
         "fraccontact/scenes/parameters.py. Each contact takes v, v2 (the bodies' v) and a, a2 (the bodies' "
         "outputs a, every force but the one of the contact they strike, and a2, every force but the one of "
-        "the contact that strikes them) and returns F_avg_next (coupling = 2: every master here is a Jacobi "
-        "master), -F on its striker's input F and +F on its second body's F2.",
+        "the contact that strikes them) and returns F_avg_next (coupling = 2, for the Jacobi masters), -F on "
+        "its striker's input F and +F on its second body's F2.",
         "",
-        "Run one: `fraccontact scene headform --master fmpy|libcosim|container|reference [--H ...] "
+        "Run one: `fraccontact scene headform --master fmpy|libcosim|container|container-gs|reference [--H ...] "
         "[--headform child] [--gap0 ...]`, `fraccontact scene bumper [--v ...]`.",
         "",
-        "**Recommended step: H = 1e-5 s** (the SSDs' step). The three masters run the SSPs as they are, with "
-        "two differences:",
+        "**Recommended step: H = 1e-5 s** (the SSDs' step). The masters run the SSPs as they are, with "
+        "these differences:",
         "",
-        "- fmpy's `simulate_ssp` starts every connector at 0 and reads no SSV binding (fraccontact.ssp passes "
-        "the bindings as its parameter set): the contacts see no motion in the first step, so the scene starts "
-        "one step late (its trace is shifted back by H). In the bumper the crash box then pulls each body "
-        "towards an anchor at rest for that step, which costs the errors below (about 5e-5).",
+        "- fmpy's `simulate_ssp` (its module fmpy.ssp.simulation) starts every connector at 0, sets every input from "
+        "its connector before each step (a start value, even one of its parameter set, does not outlive the "
+        "first step) and reads no SSV binding (fraccontact.ssp passes the bindings as its parameter set): the "
+        "contacts see no motion in the first step, in which every body flies free. With every spring and damper "
+        "inside one FMU that step is exact free flight: the scene starts one step late, and its trace shifted "
+        "back by H is libcosim's to rounding (tests/test_scenes.py::test_jacobi_masters_give_one_trace).",
         "- fmu-manipulation-toolbox 2.0 reads the SSD's components and connections but not its SSV bindings, "
         "and exposes nothing the SSD does not connect to the system's boundary: the runner gives the container "
         "the SSV values as start values and the recorded variables as outputs (fraccontact.scenes.container). "
-        "Its container steps the FMUs from the last internal step (parallel mode), as libcosim does: the two "
-        "give one trace.",
+        "By default its container steps the FMUs from the last internal step (parallel mode), as libcosim "
+        "does: the two give one trace.",
+        "- container-gs: the toolbox's sequential mode (`Assembly(sequential=True)`, `-sequential` on its "
+        "command line), in which, its source says, the FMUs \"step one after the other in the order of the "
+        "configuration, each one with the outputs just computed by the previous ones\" "
+        "(fmu_manipulation_toolbox.container.builder, check_sequential_order): Gauss-Seidel. The runner puts "
+        "the contacts first, sets their coupling = 1 and feeds the bodies F_avg in place of the SSD's F_avg_next "
+        "(fraccontact.scenes.container.gauss_seidel; docs/coupling.md).",
         "",
         "## Headform on a bonnet: masters side by side",
         "",
@@ -199,8 +213,10 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_con
         "## Low-speed bumper: masters side by side",
         "",
         f"49 CFR 581, {SPEEDS['49 CFR 581']:.4f} m/s, H = 1e-5 s, 0.2 s (the fascia has left the barrier). "
-        "energy_error: kinetic + crash box + dissipated over the impact energy, less 1 (> 0: energy created); "
-        "momentum_error: the momentum lost less the barrier's impulse (trapezoidal on the grid).",
+        "The energy balance (masters.balance): kinetic + springs (the crash box's or the panel's, and the "
+        "contacts' Hertz springs) + dissipated, over the impact energy, less 1 (> 0: energy created); "
+        "energy_error its value at the end, energy_first after the first step, energy_max its largest from the "
+        "second step on; momentum_error: the momentum lost less the barrier's impulse (trapezoidal on the grid).",
         "",
         *bumper_rows,
         "",
@@ -212,9 +228,17 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, head_conv, bumper_con
         "",
         *bumper_conv,
         "",
-        "The crash box is split across two FMUs (each body holds it, the other its anchor, moving at the "
-        "anchor's acceleration a_a over a step): the energy it creates is second order in H; held at constant "
-        "velocity instead, the anchor's error made it first order. fmpy's errors are its first step's (above).",
+        "**No energy is created**, in any master at any H: the balance at the end is negative (the coupling "
+        "dissipates, second order in H), and from the second step on it never rises above rounding "
+        "(energy_max). The one positive value is the first step's (energy_first, "
+        f"{loan:.1e} of the bumper's impact energy at H = 1e-5 in libcosim, growing as H^2.5): the energy the "
+        "contact's spring takes in that step, k (v0 H)^2.5/2.5, which the bodies have not yet paid. A Jacobi "
+        "master cannot step the contact first: its F_avg_next is 0 before its first step and announces that "
+        "step's impulse in the second (docs/coupling.md), which repays it; container-gs steps the contacts "
+        f"first and has none ({bumper_runs['container-gs']['energy_first']:.0e}). (Before the crash box lay inside "
+        "one FMU, each body held it with the other as its anchor, extrapolated over a step: that created "
+        "energy, second order in H, and fmpy's zero first exchange pulled each body towards an anchor at "
+        "rest.)",
         "",
         "## HIC15 against the clearance",
         "",

@@ -4,9 +4,14 @@
 The toolbox reads the SSP's SSD (components, connections) but not its
 parameter bindings, nor does it expose anything an SSD does not connect to
 the system's boundary: the components' values (the SSV files') become the
-container's start values, and the recorded variables its outputs. Its
-container steps every embedded FMU from the values of the last internal step
-(not sequential: a Jacobi master), with the internal step H.
+container's start values, and the recorded variables its outputs. By
+default its container steps every embedded FMU from the values of the last
+internal step (a Jacobi master), with the internal step H. In its
+sequential mode it steps them one after the other, each with the outputs the
+ones before it have just computed (Gauss-Seidel): the contacts then step
+first, from the bodies' state at the step's start, with coupling = 1, and
+the bodies take the force of that step, F_avg, in place of the SSD's
+F_avg_next (docs/coupling.md).
 """
 
 import contextlib
@@ -18,6 +23,8 @@ import tempfile
 
 from fmpy import simulate_fmu
 from fmpy.ssp.ssd import find_components, read_ssd
+
+from .systems import FMUS
 
 
 def instance_names(ssp):
@@ -32,10 +39,24 @@ def instance_names(ssp):
     return names
 
 
-def build(ssp, H, start, outputs, folder):
+def gauss_seidel(node, names, start):
+    """Makes the container's node sequential, contacts first, fed coupling =
+    1 and F_avg: start's contacts are changed in place."""
+    contacts = [names[c] for c in start if FMUS[c] == "fraccontact"]
+    node.sequential = True
+    node.fmu_names_list.sort(key=lambda name: name not in contacts)
+    for link in node.links:
+        if link.from_port.port_name == "F_avg_next":
+            link.from_port.port_name = "F_avg"
+    for component, values in start.items():
+        if FMUS[component] == "fraccontact":
+            values["coupling"] = 1
+
+
+def build(ssp, H, start, outputs, folder, sequential=False):
     """The container FMU of ssp in folder (its path): internal step H [s],
     start values start ({component: {variable: value}}), outputs the
-    recorded "component.variable" names."""
+    recorded "component.variable" names; sequential: Gauss-Seidel."""
     from fmu_manipulation_toolbox.assembly import Assembly
     # It reports the inputs the SSD leaves unconnected (the masses, the rigid barrier's v2) as errors: they
     # are set by the start values.
@@ -44,6 +65,9 @@ def build(ssp, H, start, outputs, folder):
     shutil.copy(ssp, folder / ssp.name)
     names = instance_names(ssp)
     assembly = Assembly(ssp.name, fmu_directory=folder, default_step_size=H)
+    if sequential:
+        start = {component: dict(values) for component, values in start.items()}
+        gauss_seidel(assembly.root, names, start)
     for component, values in start.items():
         for variable, value in values.items():
             assembly.root.add_start_value(names[component], variable, str(value))
@@ -54,11 +78,11 @@ def build(ssp, H, start, outputs, folder):
     return folder / f"{ssp.stem}.fmu"
 
 
-def simulate(ssp, H, t_end, start, outputs):
+def simulate(ssp, H, t_end, start, outputs, sequential=False):
     """{output: values at 0, H, ..., t_end} of the container run by fmpy at
-    communication step H."""
+    communication step H; sequential: in Gauss-Seidel order."""
     with tempfile.TemporaryDirectory() as folder:
-        fmu = build(pathlib.Path(ssp), H, start, outputs, folder)
+        fmu = build(pathlib.Path(ssp), H, start, outputs, folder, sequential)
         # fmpy prints the container's log (its mode, its solver's setup) on stdout, which is the
         # command's: to stderr. (A logger of our own would outlive the call in fmpy's proxy.)
         with contextlib.redirect_stdout(sys.stderr):

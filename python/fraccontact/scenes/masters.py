@@ -7,7 +7,7 @@ trace (figures) are computed alike for every master and the reference.
     trace = run("headform", "fmpy", H=1e-5, options={"gap0": 0.06})
     figures(trace, "headform", options)   # HIC15, peak_g, panel_deflection, ...
 
-Masters (each steps every FMU from the last communication point: Jacobi):
+Masters (each but container-gs steps every FMU from the last communication point: Jacobi):
   fmpy       fmpy.ssp.simulate_ssp, the SSP as it is. It starts every
              connector at 0, so the contacts see no motion in the first step
              and the scene starts one step late: its trace is shifted back
@@ -16,6 +16,9 @@ Masters (each steps every FMU from the last communication point: Jacobi):
              bindings and passes the outputs' initial values to the inputs.
   container  a container FMU built from the SSP by fmu-manipulation-toolbox
              (container.py), run by fmpy.
+  container-gs  the same container in the toolbox's sequential mode: the
+             contacts step first, the bodies then with their force
+             (Gauss-Seidel, coupling = 1, F_avg).
   reference  the scene's Chain (scenes.chain) solved monolithically by scipy.
 """
 
@@ -27,13 +30,16 @@ from .. import crash, fmu_path
 from ..ssp import bound_parameters
 from . import bumper as bumper_reference
 from . import headform as headform_reference
+from .chain import Contact
 from .parameters import ADULT, CHILD, SPEEDS, Bonnet, Bumper
 from .systems import CLEARANCE, RECORDED, STEP, T_END, VALUES
 
-MASTERS = ("fmpy", "libcosim", "container", "reference")
+MASTERS = ("fmpy", "libcosim", "container", "container-gs", "reference")
 HEADFORMS = {"adult": ADULT, "child": CHILD}
 # The reference's tolerance: far below the co-simulations' errors.
 RTOL = 1e-10
+# The contacts' spring: Hertz's (law 2), the exponent the references take.
+HERTZ_N = Contact.n
 
 
 def ssp_path(scene):
@@ -75,7 +81,8 @@ def run(scene, master, H=None, t_end=None, options=None):
     t_end = T_END[scene] if t_end is None else t_end
     if master == "reference":
         return reference(scene, H, t_end, options)
-    runner = {"fmpy": run_fmpy, "libcosim": run_libcosim, "container": run_container}[master]
+    runner = {"fmpy": run_fmpy, "libcosim": run_libcosim, "container": run_container,
+              "container-gs": run_container_gs}[master]
     return runner(scene, H, t_end, values(scene, options))
 
 
@@ -95,7 +102,7 @@ def run_fmpy(scene, H, t_end, start):
     rows = simulate_ssp(str(path), stop_time=t[-1] + 0.5 * H, step_size=H, parameter_set=parameters)
     trace = {name: np.asarray(rows[name][:len(t)], dtype=float) for name in RECORDED[scene]}
     for name in trace:
-        if name.endswith(".x"):
+        if name.split(".")[1] in ("x", "x_a"):
             trace[name] = trace[name] - trace[name][0]  # the first step's free flight
     return dict(trace, t=t[:len(rows)])
 
@@ -143,49 +150,58 @@ def run_libcosim(scene, H, t_end, start):
 
 
 def initial(name, start):
-    """A recorded variable's value at t = 0: a body's v0, else 0."""
+    """A recorded variable's value at t = 0: a body's v0 (and its anchor's, if free), else 0."""
     component, variable = name.split(".")
-    return float(start[component].get("v0", 0.0)) if variable == "v" else 0.0
+    values = start[component]
+    moves = variable == "v" or (variable == "v_a" and values.get("m_a", 0.0) > 0)
+    return float(values.get("v0", 0.0)) if moves else 0.0
 
 
-def run_container(scene, H, t_end, start):
+def run_container(scene, H, t_end, start, sequential=False):
     from .container import simulate
     t = grid(H, t_end)
-    series = simulate(ssp_path(scene), H, t[-1], start, RECORDED[scene])
+    series = simulate(ssp_path(scene), H, t[-1], start, RECORDED[scene], sequential)
     return dict(series, t=t[:len(series[RECORDED[scene][0]])])
+
+
+def run_container_gs(scene, H, t_end, start):
+    return run_container(scene, H, t_end, start, sequential=True)
 
 
 def reference(scene, H, t_end, options=None):
     """The scene's Chain solved by scipy, sampled on the grid of H: the same
-    names as the co-simulations record (E_diss: each dashpot's, and the
-    links' dissipation given to the body that holds them)."""
+    names as the co-simulations record (the bumper's vehicle body as the
+    beam's anchor, vehicle.v_a; E_diss: each dashpot's, and the links'
+    dissipation given to the body that holds them)."""
     args = scene_arguments(scene, options)
     if scene == "headform":
         gap0 = args.get("gap0", CLEARANCE)
         chain = headform_reference.scene(args["headform"], gap0, args["bonnet"])
         run_ = chain.solve(t_end, length=0.01, rtol=RTOL, max_step=headform_reference.MAX_STEP)
-        bodies, contacts, link_holder = ("head", "panel"), ("skin", "hard"), "panel"
+        bodies, contacts, link_holder = ("head.{}", "panel.{}"), ("skin", "hard"), "panel"
     else:
         chain = bumper_reference.scene(args["v"], args["bumper"])
         run_ = chain.solve(t_end, length=0.05, rtol=RTOL, max_step=bumper_reference.MAX_STEP)
-        bodies, contacts, link_holder = ("vehicle", "beam"), ("fascia",), "vehicle"
+        bodies, contacts, link_holder = ("vehicle.{}_a", "vehicle.{}"), ("fascia",), "vehicle"
     t = grid(H, t_end)
     y = run_.y(t)
     s = run_.series(t)
     trace = {"t": t}
     for i, body in enumerate(bodies):
-        trace[f"{body}.v"], trace[f"{body}.x"] = s["v"][i], s["u"][i]
+        trace[body.format("v")], trace[body.format("x")] = s["v"][i], s["u"][i]
     for i, contact in enumerate(contacts):
-        trace[f"{contact}.F"], trace[f"{contact}.E_diss"] = s["F"][i], y[chain.E_CONTACTS][i]
+        trace[f"{contact}.F"], trace[f"{contact}.x1"], trace[f"{contact}.E_diss"] = (s["F"][i], s["x1"][i],
+                                                                                     y[chain.E_CONTACTS][i])
     trace[f"{link_holder}.E_diss"] = y[chain.E_LINKS]
     trace["events"] = run_.events
     return trace
 
 
-def deceleration(trace, body):
+def deceleration(trace, body, velocity="v"):
     """(times, the body's deceleration [m/s^2]): the velocity's change over
-    each step / H, at the step's middle (what a held force gives)."""
-    t, v = trace["t"], trace[f"{body}.v"]
+    each step / H, at the step's middle (what a held force gives); velocity
+    v_a: of the body's anchor."""
+    t, v = trace["t"], trace[f"{body}.{velocity}"]
     H = t[1] - t[0]
     return t[:-1] + 0.5 * H, -np.diff(v) / H
 
@@ -201,38 +217,58 @@ def contact_duration(trace, contact):
     return float(t[min(on[-1] + 1, len(t) - 1)] - t[max(on[0] - 1, 0)])
 
 
+def stored(trace, contact, k):
+    """The energy in a contact's Hertz spring, k x1^(n+1)/(n+1) [J]."""
+    return k * np.maximum(trace[f"{contact}.x1"], 0.0) ** (HERTZ_N + 1) / (HERTZ_N + 1)
+
+
+def balance(trace, scene, start):
+    """The energy over the run, kinetic + springs (the bodies' and the
+    contacts') + dissipated, over the impact energy, less 1 (> 0: energy
+    created)."""
+    if scene == "headform":
+        head, panel = start["head"], start["panel"]
+        E0 = 0.5 * head["m"] * head["v0"] ** 2
+        energy = (0.5 * head["m"] * trace["head.v"] ** 2 + 0.5 * panel["m"] * trace["panel.v"] ** 2
+                  + 0.5 * panel["k_s"] * trace["panel.x"] ** 2 + stored(trace, "skin", start["skin"]["k"])
+                  + stored(trace, "hard", start["hard"]["k"])
+                  + trace["skin.E_diss"] + trace["hard.E_diss"] + trace["panel.E_diss"])
+        return energy / E0 - 1
+    vehicle = start["vehicle"]
+    M, m, v = vehicle["m_a"], vehicle["m"], vehicle["v0"]
+    energy = (0.5 * M * trace["vehicle.v_a"] ** 2 + 0.5 * m * trace["vehicle.v"] ** 2
+              + 0.5 * vehicle["k_s"] * (trace["vehicle.x_a"] - trace["vehicle.x"]) ** 2
+              + stored(trace, "fascia", start["fascia"]["k"]) + trace["fascia.E_diss"] + trace["vehicle.E_diss"])
+    return energy / (0.5 * (M + m) * v * v) - 1
+
+
 def figures(trace, scene, options=None):
     """The crash figures of a trace. headform: the head's HIC15 (CFC 1000,
     crash.figures) with its window, peak g, 3 ms clip, the panel's
     deflection, the head's travel, the skin contact's duration, the head's
-    restitution (-v_end/v0), energy_error. bumper: F_peak, crush (the
-    vehicle's travel), the vehicle's peak g, the fascia's duration, the
-    system's restitution (-momentum at the end / (M + m_b) v), energy_error
-    and momentum_error (the momentum lost against the barrier's impulse)."""
+    restitution (-v_end/v0). bumper: F_peak, crush (the vehicle's travel),
+    the vehicle's peak g, the fascia's duration, the system's restitution
+    (-momentum at the end / (M + m_b) v), momentum_error (the momentum lost
+    against the barrier's impulse). Both: energy_error, the balance at the
+    end; energy_first, after the first step; energy_max, its largest from the
+    second step on."""
     start = values(scene, options)
+    energy = balance(trace, scene, start)
+    energies = dict(energy_error=float(energy[-1]), energy_first=float(energy[1]), energy_max=float(energy[2:].max()))
     if scene == "headform":
-        head, panel = start["head"], start["panel"]
+        head = start["head"]
         f = crash.figures(*deceleration(trace, "head"))
-        E0 = 0.5 * head["m"] * head["v0"] ** 2
-        energy = (0.5 * head["m"] * trace["head.v"] ** 2 + 0.5 * panel["m"] * trace["panel.v"] ** 2
-                  + 0.5 * panel["k_s"] * trace["panel.x"] ** 2
-                  + trace["skin.E_diss"] + trace["hard.E_diss"] + trace["panel.E_diss"])
         return dict(HIC15=f["HIC15"], HIC15_window=f["HIC15_window"], peak_g=f["peak_g"], clip3ms_g=f["clip3ms_g"],
                     panel_deflection=float(trace["panel.x"].max()), head_travel=float(trace["head.x"].max()),
                     duration=contact_duration(trace, "skin"), restitution=float(-trace["head.v"][-1] / head["v0"]),
-                    energy_error=float(energy[-1] / E0 - 1))
-    vehicle, beam = start["vehicle"], start["beam"]
-    M, m, v = vehicle["m"], beam["m"], vehicle["v0"]
-    _, a = deceleration(trace, "vehicle")
+                    **energies)
+    vehicle = start["vehicle"]
+    M, m, v = vehicle["m_a"], vehicle["m"], vehicle["v0"]
+    _, a = deceleration(trace, "vehicle", "v_a")
     t, F = trace["t"], trace["fascia.F"]
-    p = M * trace["vehicle.v"] + m * trace["beam.v"]
+    p = M * trace["vehicle.v_a"] + m * trace["vehicle.v"]
     impulse = np.concatenate([[0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t))])
-    energy = (0.5 * M * trace["vehicle.v"] ** 2 + 0.5 * m * trace["beam.v"] ** 2
-              + 0.5 * vehicle["k_s"] * (trace["vehicle.x"] - trace["beam.x"]) ** 2
-              + trace["fascia.E_diss"] + trace["vehicle.E_diss"])
-    return dict(F_peak=float(F.max()), crush=float(trace["vehicle.x"].max()),
+    return dict(F_peak=float(F.max()), crush=float(trace["vehicle.x_a"].max()),
                 peak_g=float(np.max(np.abs(a)) / crash.STANDARD_GRAVITY),
                 duration=contact_duration(trace, "fascia"), restitution=float(-p[-1] / ((M + m) * v)),
-                energy_error=float(energy[-1] / (0.5 * (M + m) * v * v) - 1),
-                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)))
-
+                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)), **energies)

@@ -11,10 +11,11 @@ headform: the headform (body.fmu, no spring) strikes the panel (body.fmu on
 its bending stiffness and damping to the ground) through the contact
 `skin`; the panel strikes the hard point (the ground) through the contact
 `hard` once it has travelled the clearance gap0.
-bumper: the vehicle body and the beam (body.fmu each, the crash box's
-spring and damper between them: each is the other's anchor) at the impact
-speed; the beam's fascia strikes the rigid barrier through the contact
-`fascia`.
+bumper: the vehicle (body.fmu: the bumper beam its body, the vehicle's
+body its free anchor, the crash box's spring and damper between them) at
+the impact speed; the beam's fascia strikes the rigid barrier through the
+contact `fascia`. No spring or damper is split across FMUs: the contacts
+are the only coupling between them.
 """
 
 import argparse
@@ -32,15 +33,17 @@ CONTACT = {"scene": 2, "law": 2, "coupling": 2}
 # crosses 1000 (docs/scenes.md), so that the panel reaches the hard point.
 CLEARANCE = 0.065
 SCENES = ("headform", "bumper")
-COMPONENTS = {"headform": ("head", "panel", "skin", "hard"), "bumper": ("vehicle", "beam", "fascia")}
+COMPONENTS = {"headform": ("head", "panel", "skin", "hard"), "bumper": ("vehicle", "fascia")}
 FMUS = {"head": "body", "panel": "body", "skin": "fraccontact", "hard": "fraccontact",
-        "vehicle": "body", "beam": "body", "fascia": "fraccontact"}
+        "vehicle": "body", "fascia": "fraccontact"}
 # What each scene's co-simulation records: the bodies' velocities and
-# positions, the contacts' force, the work the contacts and dampers dissipate
-# (the crash box's once: both bodies hold it).
-RECORDED = {"headform": ("head.v", "head.x", "panel.v", "panel.x", "skin.F", "hard.F", "skin.E_diss", "hard.E_diss",
-                         "panel.E_diss"),
-            "bumper": ("vehicle.v", "vehicle.x", "beam.v", "beam.x", "fascia.F", "fascia.E_diss", "vehicle.E_diss")}
+# positions (the bumper's beam: vehicle.v, vehicle.x; the vehicle's body, the
+# beam's anchor: vehicle.v_a, vehicle.x_a), the contacts' force and spring
+# deflection x1, the work the contacts and dampers dissipate.
+RECORDED = {"headform": ("head.v", "head.x", "panel.v", "panel.x", "skin.F", "hard.F", "skin.x1", "hard.x1",
+                         "skin.E_diss", "hard.E_diss", "panel.E_diss"),
+            "bumper": ("vehicle.v_a", "vehicle.x_a", "vehicle.v", "vehicle.x", "fascia.F", "fascia.x1",
+                       "fascia.E_diss", "vehicle.E_diss")}
 # The communication step the SSDs carry and the docs recommend, and the
 # simulated time: the head has left the panel, the fascia the barrier.
 STEP = {"headform": 1e-5, "bumper": 1e-5}
@@ -63,8 +66,7 @@ def bumper_values(v=SPEEDS["49 CFR 581"], bumper=Bumper()):
     if not (v > 0 and math.isfinite(v)):
         raise ValueError(f"v = {v} is invalid: the impact speed must be finite and > 0 [m/s]")
     k, c = fascia(bumper)
-    box = {"k_s": bumper.k_box, "c_s": bumper.c_box, "v0": v}
-    return {"vehicle": dict(box, m=bumper.M), "beam": dict(box, m=bumper.m_b),
+    return {"vehicle": {"m": bumper.m_b, "m_a": bumper.M, "k_s": bumper.k_box, "c_s": bumper.c_box, "v0": v},
             "fascia": dict(CONTACT, k=k, c=c, m=bumper.m_b, v=v)}
 
 
