@@ -69,30 +69,36 @@ typedef struct {
 } esdirk_moments;
 
 /* The start's sums S, D, W for a step of length h; returns inv_B. The
- * sums in local variables: the compiler keeps them in registers. */
+ * sums in local variables: the compiler keeps them in registers. Per mode
+ * only D and W, whose terms a d u^m keep their precision however stiff the
+ * mode (d small, u near 1); S follows from them, S[m + 1] = S[m] - D[m]
+ * (u = 1 - d), each difference exact to rounding of the memory's force S[0]. */
 static double esdirk_moments_begin(const contact_model *cm, double h, esdirk_moments *mom)
 {
     const contact_modes *m = &cm->modes;
     const double hg = ESDIRK_GAMMA * h;
-    double S[ESDIRK_STAGES] = {0.0}, D[ESDIRK_DEGREES] = {0.0}, W[ESDIRK_DEGREES] = {0.0};
+    double S0 = 0.0, D[ESDIRK_DEGREES] = {0.0}, W[ESDIRK_DEGREES] = {0.0};
     size_t j;
     int k;
     for (j = 0; j < m->modes; j++) {
-        const double d = 1.0 / (1.0 + hg * m->b[j]), u = hg * m->b[j] * d;
+        const double hb = hg * m->b[j], d = 1.0 / (1.0 + hb), u = hb * d;
         double x = m->a[j] * m->phi[j], y = m->a[j] * d;
+        S0 += x;
+        x *= d;
         for (k = 0; k < ESDIRK_DEGREES; k++) {
-            D[k] += d * x;
+            D[k] += x;
             W[k] += y;
             x *= u;
             y *= u;
-            S[k + 1] += x;
         }
     }
-    memcpy(mom->S, S, sizeof S);
+    mom->S[0] = S0;
+    for (k = 0; k < ESDIRK_DEGREES; k++)
+        mom->S[k + 1] = mom->S[k] - D[k];
     memcpy(mom->D, D, sizeof D);
     memcpy(mom->W, W, sizeof W);
     for (k = 1; k < ESDIRK_STAGES; k++)
-        mom->mu[0][k] = S[k];
+        mom->mu[0][k] = mom->S[k];
     return 1.0 / (cm->p.c_alpha * (m->eta + hg * W[0]));
 }
 
@@ -146,39 +152,45 @@ static void esdirk_trial_rates(const contact_model *cm, const contact_state *tri
 /* The modes after an accepted ESDIRK step from the model's state: the last
  * stage's (stiffly accurate), so that whichever of an event search's trials
  * is accepted brings its own. By the recursion of esdirk_moments each
- * stage's modes are a polynomial in u, phi_i = sum_m u^m (P_i[m] phi_n + w_i[m]),
- * its coefficients from the tableau (P) and the trial's rates (w):
+ * stage's modes are a polynomial in u, phi_i = P_i(u) phi_n + w_i(u), its
+ * coefficients from the tableau (P) and the trial's rates (w):
  *     P_i[m] = [m = 0] - [m = 1] - (1/gamma) sum_{k<i} a_ik P_k[m - 1],
  *     w_i[m] = h (Z_i + gamma z_i) ([m = 0] - [m = 1]) - (1/gamma) sum_{k<i} a_ik w_k[m - 1],
- * so that a mode's end is one Horner evaluation. */
+ * (P_k and w_k of degree k: the sums start at k = m - 1), so that a mode's
+ * end is two independent Horner evaluations. */
 void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
 {
+    const int last = ESDIRK_STAGES - 1;
     contact_modes *m = &cm->modes;
     const double h = trial->step, hg = ESDIRK_GAMMA * h;
-    double P[ESDIRK_STAGES][ESDIRK_STAGES] = {{1.0}}, w[ESDIRK_STAGES][ESDIRK_STAGES] = {{0.0}}, z[ESDIRK_STAGES];
+    double P[ESDIRK_STAGES][ESDIRK_STAGES], w[ESDIRK_STAGES][ESDIRK_STAGES], z[ESDIRK_STAGES];
     size_t j;
     int i, k, n;
     esdirk_trial_rates(cm, trial, z);
+    P[0][0] = 1.0;
+    w[0][0] = 0.0;
     for (i = 1; i < ESDIRK_STAGES; i++) {
         double Z = ESDIRK_GAMMA * z[i];
         for (k = 0; k < i; k++)
             Z += esdirk_a[i][k] * z[k];
-        P[i][0] = 1.0;
-        P[i][1] = -1.0;
-        w[i][0] = h * Z;
-        w[i][1] = -h * Z;
-        for (n = 1; n <= i; n++)
-            for (k = 0; k < i; k++) {
-                P[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * P[k][n - 1];
-                w[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * w[k][n - 1];
+        for (n = 0; n <= i; n++) {
+            double p = n == 0 ? 1.0 : n == 1 ? -1.0 : 0.0, q = p * h * Z;
+            for (k = n > 0 ? n - 1 : i; k < i; k++) {
+                p -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * P[k][n - 1];
+                q -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * w[k][n - 1];
             }
+            P[i][n] = p;
+            w[i][n] = q;
+        }
     }
     for (j = 0; j < m->modes; j++) {
-        const double u = hg * m->b[j] / (1.0 + hg * m->b[j]), phi = m->phi[j];
-        double end = P[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1] * phi + w[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1];
-        for (n = ESDIRK_STAGES - 2; n >= 0; n--)
-            end = end * u + (P[ESDIRK_STAGES - 1][n] * phi + w[ESDIRK_STAGES - 1][n]);
-        m->phi[j] = end;
+        const double u = hg * m->b[j] / (1.0 + hg * m->b[j]);
+        double keep = P[last][last], add = w[last][last];
+        for (n = last - 1; n >= 0; n--) {
+            keep = keep * u + P[last][n];
+            add = add * u + w[last][n];
+        }
+        m->phi[j] = keep * m->phi[j] + add;
     }
 }
 
