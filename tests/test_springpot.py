@@ -1091,3 +1091,19 @@ def test_the_bench_times_the_impacts_the_library_computes():
     assert h20["dashpot"]["F_peak"] == fraccontact.impact(dt_max=1e-7).F_peak
     assert h20["compressed"]["F_peak"] == fraccontact.impact(**springpot).F_peak
     assert h20["full"]["F_peak"] == fraccontact.impact(memory=1, **springpot).F_peak
+
+
+@pytest.mark.parametrize("tolerance", [1e-6, 1e-8])
+def test_the_controlled_bench_times_the_impacts_the_library_computes(tolerance):
+    """fraccontact-bench controlled (docs/benchmarks.md, the springpot under
+    error control) times the error-controlled h20 impact of each damper: the
+    library's impact, the same steps and figures to the last bit."""
+    bench = os.environ.get("FRACCONTACT_BENCH", str(ROOT / "build" / "fraccontact-bench"))
+    done = subprocess.run([bench, "controlled", f"{tolerance:g}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    timed = json.loads(done.stdout)
+    for name, damper in (("dashpot", 1), ("springpot", 2)):
+        r = fraccontact.impact(law=2, damper=damper, tolerance=tolerance)
+        assert timed[name]["steps"] == r.steps, name
+        for figure in ("F_peak", "eps", "t_contact", "x2_end", "E_diss"):
+            assert timed[name][figure] == getattr(r, figure), (name, figure)

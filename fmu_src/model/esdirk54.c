@@ -69,30 +69,36 @@ typedef struct {
 } esdirk_moments;
 
 /* The start's sums S, D, W for a step of length h; returns inv_B. The
- * sums in local variables: the compiler keeps them in registers. */
+ * sums in local variables: the compiler keeps them in registers. Per mode
+ * only D and W, whose terms a d u^m keep their precision however stiff the
+ * mode (d small, u near 1); S follows from them, S[m + 1] = S[m] - D[m]
+ * (u = 1 - d), each difference exact to rounding of the memory's force S[0]. */
 static double esdirk_moments_begin(const contact_model *cm, double h, esdirk_moments *mom)
 {
     const contact_modes *m = &cm->modes;
     const double hg = ESDIRK_GAMMA * h;
-    double S[ESDIRK_STAGES] = {0.0}, D[ESDIRK_DEGREES] = {0.0}, W[ESDIRK_DEGREES] = {0.0};
+    double S0 = 0.0, D[ESDIRK_DEGREES] = {0.0}, W[ESDIRK_DEGREES] = {0.0};
     size_t j;
     int k;
     for (j = 0; j < m->modes; j++) {
-        const double d = 1.0 / (1.0 + hg * m->b[j]), u = hg * m->b[j] * d;
+        const double hb = hg * m->b[j], d = 1.0 / (1.0 + hb), u = hb * d;
         double x = m->a[j] * m->phi[j], y = m->a[j] * d;
+        S0 += x;
+        x *= d;
         for (k = 0; k < ESDIRK_DEGREES; k++) {
-            D[k] += d * x;
+            D[k] += x;
             W[k] += y;
             x *= u;
             y *= u;
-            S[k + 1] += x;
         }
     }
-    memcpy(mom->S, S, sizeof S);
+    mom->S[0] = S0;
+    for (k = 0; k < ESDIRK_DEGREES; k++)
+        mom->S[k + 1] = mom->S[k] - D[k];
     memcpy(mom->D, D, sizeof D);
     memcpy(mom->W, W, sizeof W);
     for (k = 1; k < ESDIRK_STAGES; k++)
-        mom->mu[0][k] = S[k];
+        mom->mu[0][k] = mom->S[k];
     return 1.0 / (cm->p.c_alpha * (m->eta + hg * W[0]));
 }
 
@@ -143,19 +149,36 @@ static void esdirk_trial_rates(const contact_model *cm, const contact_state *tri
     z[ESDIRK_STAGES - 1] = trial->x2_rate;
 }
 
+/* The last stage's modes as a polynomial in u: by the recursion of
+ * esdirk_moments each stage's modes are phi_i = sum_m u^m q_i[m],
+ *     q_0[0] = phi_n,
+ *     q_i[m] = ([m = 0] - [m = 1]) (phi_n + h Zt_i) - (1/gamma) sum_{k<i} a_ik q_k[m - 1],
+ *     Zt_i = sum_{k<i} a_ik z_k + gamma z_i,
+ * linear in phi_n and the h Zt_l, so that the last stage's coefficients are
+ *     q_6[m] = ESDIRK_LAST_STAGE[m][0] phi_n + sum_{l>=1} ESDIRK_LAST_STAGE[m][l] h Zt_l,
+ * the table below that recursion's from each unit (phi_n = 1 or one h Zt_l =
+ * 1), to 17 digits: constants of the tableau, where the recursion on every
+ * accepted step would cost more than the modes' own update
+ * (tests/test_contact.c checks them against the stages taken one by one). */
+static const double ESDIRK_LAST_STAGE[ESDIRK_STAGES][ESDIRK_STAGES] = {
+    {1, 0, 0, 0, 0, 0, 1},
+    {-3.8461538461538458, 0, 0.21141956909762985, 0.15840872032004025, -2.4228194191929382, -0.26778767108472029, -1},
+    {3.5502958579881638, 0, 0.12268131785870509, -1.3530713408788944, 3.0608033489286859, 0.26778767108472029, 0},
+    {1.4641177363070845, 0.85437020047787537, -0.72053796936316161, 1.5158802770475246, -0.63798392973574747, 0, 0},
+    {-0.98677684021334378, -0.19439448404171211, 0.46638192255768962, -0.32121765648867029, 0, 0, 0},
+    {-1.6982544782691826, -0.91836150160672481, -0.079944840150862978, 0, 0, 0, 0},
+    {0.51677157034112287, 0.25838578517056143, 0, 0, 0, 0, 0}};
+
 /* The modes after an accepted ESDIRK step from the model's state: the last
  * stage's (stiffly accurate), so that whichever of an event search's trials
- * is accepted brings its own. By the recursion of esdirk_moments each
- * stage's modes are a polynomial in u, phi_i = sum_m u^m (P_i[m] phi_n + w_i[m]),
- * its coefficients from the tableau (P) and the trial's rates (w):
- *     P_i[m] = [m = 0] - [m = 1] - (1/gamma) sum_{k<i} a_ik P_k[m - 1],
- *     w_i[m] = h (Z_i + gamma z_i) ([m = 0] - [m = 1]) - (1/gamma) sum_{k<i} a_ik w_k[m - 1],
- * so that a mode's end is one Horner evaluation. */
+ * is accepted brings its own; each mode's end two independent Horner
+ * evaluations in its u. */
 void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
 {
+    const int last = ESDIRK_STAGES - 1;
     contact_modes *m = &cm->modes;
     const double h = trial->step, hg = ESDIRK_GAMMA * h;
-    double P[ESDIRK_STAGES][ESDIRK_STAGES] = {{1.0}}, w[ESDIRK_STAGES][ESDIRK_STAGES] = {{0.0}}, z[ESDIRK_STAGES];
+    double z[ESDIRK_STAGES], rate[ESDIRK_STAGES], add[ESDIRK_STAGES];
     size_t j;
     int i, k, n;
     esdirk_trial_rates(cm, trial, z);
@@ -163,22 +186,21 @@ void esdirk_advance_modes(contact_model *cm, const contact_state *trial)
         double Z = ESDIRK_GAMMA * z[i];
         for (k = 0; k < i; k++)
             Z += esdirk_a[i][k] * z[k];
-        P[i][0] = 1.0;
-        P[i][1] = -1.0;
-        w[i][0] = h * Z;
-        w[i][1] = -h * Z;
-        for (n = 1; n <= i; n++)
-            for (k = 0; k < i; k++) {
-                P[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * P[k][n - 1];
-                w[i][n] -= esdirk_a[i][k] * (1.0 / ESDIRK_GAMMA) * w[k][n - 1];
-            }
+        rate[i] = h * Z;
+    }
+    for (n = 0; n < ESDIRK_STAGES; n++) {
+        add[n] = 0.0;
+        for (i = 1; i < ESDIRK_STAGES; i++)
+            add[n] += ESDIRK_LAST_STAGE[n][i] * rate[i];
     }
     for (j = 0; j < m->modes; j++) {
-        const double u = hg * m->b[j] / (1.0 + hg * m->b[j]), phi = m->phi[j];
-        double end = P[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1] * phi + w[ESDIRK_STAGES - 1][ESDIRK_STAGES - 1];
-        for (n = ESDIRK_STAGES - 2; n >= 0; n--)
-            end = end * u + (P[ESDIRK_STAGES - 1][n] * phi + w[ESDIRK_STAGES - 1][n]);
-        m->phi[j] = end;
+        const double u = hg * m->b[j] / (1.0 + hg * m->b[j]);
+        double keep = ESDIRK_LAST_STAGE[last][0], more = add[last];
+        for (n = last - 1; n >= 0; n--) {
+            keep = keep * u + ESDIRK_LAST_STAGE[n][0];
+            more = more * u + add[n];
+        }
+        m->phi[j] = keep * m->phi[j] + more;
     }
 }
 
