@@ -573,21 +573,11 @@ static double bodies_accel(const fmu_model *fm)
     return fm->params.g + other_accel(&fm->in);
 }
 
-/* The proxy's work on the contact from the state *from to *to under its
- * held acceleration: the kinetic energy it gives up plus that
- * acceleration's work. */
-static double proxy_work(const contact_model *cm, const contact_state *from, const contact_state *to)
-{
-    return (0.5 * (from->v - to->v) * (from->v + to->v) + cm->accel * (to->x1 + to->x2 - from->x1 - from->x2))
-           / cm->inv_m;
-}
-
-/* A whole communication step [t, t + H] taken from the proxy state
- * *start, the proxy velocity u0 settled: its interval in the energy
- * account, and the correction to the force output for the bodies'
+/* A whole communication step [t, t + H] taken from the settled proxy
+ * velocity u0: its interval in the energy account, and the correction to the force output for the bodies'
  * interval that has not yet begun to take it (this one under
  * Gauss-Seidel, the next under Jacobi). */
-static void account_step(fmu_model *fm, double t, double H, const contact_state *start, double u0)
+static void account_step(fmu_model *fm, double t, double H, double u0)
 {
     coupling_energy *e = &fm->energy, next;
     const contact_model *cm = &fm->model;
@@ -597,9 +587,8 @@ static void account_step(fmu_model *fm, double t, double H, const contact_state 
     e->u0 = u0;
     e->u1 = settled_velocity(fm, cm->s.v);
     e->F_end = cm->s.F;
-    e->work = proxy_work(cm, start, &cm->s);
     if (gauss_seidel) {
-        fm->correction = coupling_energy_correction(e, m, H, e->created, e->exact, fm->F_avg, !cm->s.in_contact);
+        fm->correction = coupling_energy_correction(e, m, H, e->created, fm->F_avg);
         e->F += fm->correction;
         return;
     }
@@ -613,10 +602,8 @@ static void account_step(fmu_model *fm, double t, double H, const contact_state 
     next.u1 = next.u - e->u1
               + (fm->next.valid ? fm->next.model.s.v : e->u1 + fm->step_H * (a - fm->F_avg_next / m));
     next.F_end = fm->next.valid ? fm->next.model.s.F : fm->F_avg;
-    next.work = fm->next.valid ? proxy_work(cm, &cm->s, &fm->next.model.s) : 0.0;
     fm->correction = coupling_energy_correction(&next, m, fm->step_H, coupling_energy_predicted(e, m, H),
-                                                coupling_energy_predicted_exact(e, m, H), fm->F_avg_next,
-                                                !(fm->next.valid ? fm->next.model.s.in_contact : cm->s.in_contact));
+                                                fm->F_avg_next);
 }
 
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
@@ -715,7 +702,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
     if (proxy_striker(fm) && !resume && !*event)
-        account_step(fm, t, H, &before, u0);
+        account_step(fm, t, H, u0);
     else { /* a step cut at an event: left out of the account */
         fm->energy.open = 0;
         fm->correction = 0.0;
@@ -783,8 +770,8 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.t), F(energy.u), F(energy.a),
-    F(energy.a_rate), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), F(energy.work), I(energy.open), F(correction),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.t), F(energy.u), F(energy.a),
+    F(energy.a_rate), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -197,17 +197,15 @@ typedef struct {
  * §17a), over the intervals of the communication steps: from the bodies'
  * approach speed u and acceleration a apart from the contact (g + a - a2)
  * at each interval's ends, the force F they take over it, and the proxy's
- * motion over it, the energy the coupling creates: all of it (exact), and
- * the part that does not return when the contact's force does (created). */
+ * motion over it, the energy the coupling creates and does not return when
+ * the contact's force does. */
 typedef struct {
     double created;      /* over the closed intervals [J]; > 0: energy created */
-    double exact;        /* the same, all of it: the proxy's work less the bodies' [J] */
     double t, u, a;      /* the open interval: its start, the bodies' u and a there */
     double a_rate;       /* a's rate over the last closed interval (0 before one) */
     double F;            /* the force the bodies take over the open interval [N] */
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
-    double work;         /* the proxy's work on the contact over it [J] */
     int open;            /* an interval whose end the next inputs tell */
 } coupling_energy;
 
@@ -218,24 +216,20 @@ double coupling_energy_created(double m, double H, double u0, double u1, double 
                                double u_end, double a_start, double a_end, double F);
 
 /* Opens the interval at t from the bodies' u and a, under the force F (set
- * e->u0, e->u1, e->F_end, e->work as the proxy moves); closes it at t from
+ * e->u0, e->u1, e->F_end as the proxy moves); closes it at t from
  * the bodies' u and a there, adding what it created and taking a's rate. */
 void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F);
 void coupling_energy_close(coupling_energy *e, double m, double t, double u, double a);
 
 /* e->created with the open interval of length H closed as its start and
- * a's rate predict; the same for e->exact. */
+ * a's rate predict. */
 double coupling_energy_predicted(const coupling_energy *e, double m, double H);
-double coupling_energy_predicted_exact(const coupling_energy *e, double m, double H);
 
 /* The change to the force F0 held over the open interval of length H that
  * brings `created` (the account before it) plus what it creates to 0 where
- * that is > 0, and, where the interval is the `last` with a force (the
- * proxy ends it out of contact), `exact` plus what it creates too: only
- * ever taking more energy from the bodies; 0 otherwise. The change is never
- * larger than F0 itself (a force >= 0 stays so). */
-double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double exact,
-                                  double F0, int last);
+ * that is > 0: only ever taking more energy from the bodies; 0 otherwise.
+ * The change is never larger than F0 itself (a force >= 0 stays so). */
+double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double F0);
 
 /* The paper's h20 test (docs/model.md §1): the parameters, and the
  * striker's impact velocity v [m/s] and mass m [kg]. */

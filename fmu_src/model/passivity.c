@@ -6,16 +6,8 @@
 
 #include "contact.h"
 
-/* The bodies' displacement over an interval of length H: Hermite's
- * quadrature of their approach speed, whose rate a - F/m is known at both
- * ends with the held force F the same (so it cancels). */
-static double real_displacement(double H, double u_start, double u_end, double a_start, double a_end)
-{
-    return 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;
-}
-
 /* The energy one interval of length H creates that does not return: the
- * proxy's kinetic energy given up, plus the work its held acceleration a0
+ * proxy's kinetic energy given up, plus the work its held acceleration a_start
  * does on the bodies' real path less that acceleration's own change, less
  * the work the bodies do on the contact (F held over their displacement),
  * less the work the change of a does against the force the contact holds
@@ -24,7 +16,9 @@ static double real_displacement(double H, double u_start, double u_end, double a
 double coupling_energy_created(double m, double H, double u0, double u1, double F_end, double u_start,
                                double u_end, double a_start, double a_end, double F)
 {
-    const double dx = real_displacement(H, u_start, u_end, a_start, a_end);
+    /* the bodies' displacement: Hermite's quadrature of their approach speed,
+     * whose rate a - F/m is known at both ends with F the same (it cancels) */
+    const double dx = 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;
     const double da = a_end - a_start;
     return m * (0.5 * (u0 - u1) * (u0 + u1) + a_start * (dx - da * H * H / 6.0)) - F * dx
            - F_end * da * H * H / 12.0;
@@ -32,10 +26,10 @@ double coupling_energy_created(double m, double H, double u0, double u1, double 
 
 /* The account's interval from (u, a) of length H with the force F held on
  * the bodies, their end extrapolated from the acceleration's rate. */
-static double predicted_created(const coupling_energy *e, double m, double H, double u, double a, double F)
+static double predicted_created(const coupling_energy *e, double m, double H, double F)
 {
-    const double u_end = u + H * a + 0.5 * H * H * e->a_rate - F * H / m;
-    return coupling_energy_created(m, H, e->u0, e->u1, e->F_end, u, u_end, a, a + H * e->a_rate, F);
+    const double u_end = e->u + H * e->a + 0.5 * H * H * e->a_rate - F * H / m;
+    return coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, u_end, e->a, e->a + H * e->a_rate, F);
 }
 
 void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F)
@@ -52,7 +46,6 @@ void coupling_energy_close(coupling_energy *e, double m, double t, double u, dou
     const double H = t - e->t;
     if (e->open && H > 0.0) {
         e->created += coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, u, e->a, a, e->F);
-        e->exact += e->work - e->F * real_displacement(H, e->u, u, e->a, a);
         e->a_rate = (a - e->a) / H;
     }
     e->open = 0;
@@ -60,19 +53,7 @@ void coupling_energy_close(coupling_energy *e, double m, double t, double u, dou
 
 double coupling_energy_predicted(const coupling_energy *e, double m, double H)
 {
-    return e->created + predicted_created(e, m, H, e->u, e->a, e->F);
-}
-
-/* The bodies' displacement over the open interval of length H under the
- * force F, their acceleration extrapolated from its rate. */
-static double predicted_displacement(const coupling_energy *e, double m, double H, double F)
-{
-    return H * e->u + 0.5 * H * H * (e->a - F / m) + H * H * H * e->a_rate / 6.0;
-}
-
-double coupling_energy_predicted_exact(const coupling_energy *e, double m, double H)
-{
-    return e->exact + e->work - e->F * predicted_displacement(e, m, H, e->F);
+    return e->created + predicted_created(e, m, H, e->F);
 }
 
 /* The smallest change d of the force, in the sign of g (the direction in
@@ -87,18 +68,12 @@ static double smallest_change(double E, double g, double c)
     return disc < 0.0 ? g / (2.0 * c) : 2.0 * E / (g + copysign(sqrt(disc), g));
 }
 
-/* c = H^2/(2m): the held force's work over the displacement it shortens.
- * The larger change of the two accounts' when `last`; never larger than
- * F0 itself (a force >= 0 stays so). */
-double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double exact,
-                                  double F0, int last)
+/* c = H^2/(2m): the held force's work over the displacement it shortens;
+ * X: the bodies' displacement without it. */
+double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double F0)
 {
-    const double c = 0.5 * H * H / m, X = predicted_displacement(e, m, H, 0.0);
-    double d = smallest_change(created + predicted_created(e, m, H, e->u, e->a, F0), X + m * e->a * c - 2.0 * c * F0, c);
-    if (last) {
-        const double d_exact = smallest_change(exact + e->work - F0 * (X - c * F0), X - 2.0 * c * F0, c);
-        if (fabs(d_exact) > fabs(d))
-            d = d_exact;
-    }
+    const double c = 0.5 * H * H / m;
+    const double X = H * e->u + 0.5 * H * H * e->a + H * H * H * e->a_rate / 6.0;
+    const double d = smallest_change(created + predicted_created(e, m, H, F0), X + m * e->a * c - 2.0 * c * F0, c);
     return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
 }
