@@ -596,8 +596,8 @@ static void account_step(fmu_model *fm, double t, double H, double u0)
      * the proxy's motion predicted from its own end (owing nothing then),
      * moved by the difference of the two starts */
     next = *e;
-    coupling_energy_open(&next, t + H, approach(&fm->in) + H * (a + 0.5 * H * e->a_rate - e->F / m),
-                         a + H * e->a_rate, fm->F_avg_next);
+    coupling_energy_open(&next, t + H, coupling_energy_end_velocity(e, m, H, e->F), a + H * e->a_rate,
+                         fm->F_avg_next);
     next.u0 = next.u;
     next.u1 = next.u - e->u1
               + (fm->next.valid ? fm->next.model.s.v : e->u1 + fm->step_H * (a - fm->F_avg_next / m));
@@ -771,7 +771,7 @@ static const state_field state_fields[] = {
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.t), F(energy.u), F(energy.a),
-    F(energy.a_rate), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), I(energy.open), F(correction),
+    F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -203,6 +203,8 @@ typedef struct {
     double created;      /* over the closed intervals [J]; > 0: energy created */
     double t, u, a;      /* the open interval: its start, the bodies' u and a there */
     double a_rate;       /* a's rate over the last closed interval (0 before one) */
+    double a_unseen;     /* the bodies' mean acceleration over it that neither a nor F explains: a force
+                            the inputs do not show (0 where a holds all the other forces) */
     double F;            /* the force the bodies take over the open interval [N] */
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
@@ -221,8 +223,10 @@ double coupling_energy_created(double m, double H, double u0, double u1, double 
 void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F);
 void coupling_energy_close(coupling_energy *e, double m, double t, double u, double a);
 
-/* e->created with the open interval of length H closed as its start and
- * a's rate predict. */
+/* The bodies' approach speed at the end of the open interval of length H
+ * under the force F, from its start, a, a's rate and the unseen
+ * acceleration; e->created with that interval closed there. */
+double coupling_energy_end_velocity(const coupling_energy *e, double m, double H, double F);
 double coupling_energy_predicted(const coupling_energy *e, double m, double H);
 
 /* The change to the force F0 held over the open interval of length H that

@@ -24,12 +24,17 @@ double coupling_energy_created(double m, double H, double u0, double u1, double 
            - F_end * da * H * H / 12.0;
 }
 
-/* The account's interval from (u, a) of length H with the force F held on
- * the bodies, their end extrapolated from the acceleration's rate. */
+double coupling_energy_end_velocity(const coupling_energy *e, double m, double H, double F)
+{
+    return e->u + H * (e->a + e->a_unseen + 0.5 * H * e->a_rate - F / m);
+}
+
+/* What the open interval of length H creates with the force F held on the
+ * bodies, their end predicted. */
 static double predicted_created(const coupling_energy *e, double m, double H, double F)
 {
-    const double u_end = e->u + H * e->a + 0.5 * H * H * e->a_rate - F * H / m;
-    return coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, u_end, e->a, e->a + H * e->a_rate, F);
+    return coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, coupling_energy_end_velocity(e, m, H, F), e->a,
+                                   e->a + H * e->a_rate, F);
 }
 
 void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F)
@@ -47,6 +52,7 @@ void coupling_energy_close(coupling_energy *e, double m, double t, double u, dou
     if (e->open && H > 0.0) {
         e->created += coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, u, e->a, a, e->F);
         e->a_rate = (a - e->a) / H;
+        e->a_unseen = (u - e->u) / H + e->F / m - 0.5 * (e->a + a);
     }
     e->open = 0;
 }
@@ -73,7 +79,7 @@ static double smallest_change(double E, double g, double c)
 double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double F0)
 {
     const double c = 0.5 * H * H / m;
-    const double X = H * e->u + 0.5 * H * H * e->a + H * H * H * e->a_rate / 6.0;
+    const double X = H * e->u + 0.5 * H * H * (e->a + e->a_unseen) + H * H * H * e->a_rate / 6.0;
     const double d = smallest_change(created + predicted_created(e, m, H, F0), X + m * e->a * c - 2.0 * c * F0, c);
     return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
 }
