@@ -243,12 +243,16 @@ def test_a_spring_fed_as_a_creates_no_energy(coupling, H):
 
 
 @pytest.mark.parametrize("H", STEPS)
-def test_a_spring_the_contact_does_not_see_creates_no_energy_under_gauss_seidel(H):
+@pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
+def test_a_spring_the_contact_does_not_see_creates_no_energy(coupling, H):
     """Blind (a not fed), the account still sees the bodies' velocities at
     both ends of each step, and the energy the unseen spring makes the
     coupling create (first order in H on main: +7.8e-4 E0 at 1e-5 s) is
-    taken back under Gauss-Seidel (measured -9.9e-9 to -7.6e-3 E0)."""
-    r = cosimulate(CONTACT, STRIKER, H, "mass-aware", "gauss-seidel", k_s=K_S)
+    taken back (measured -9.9e-9 to -9.8e-3 E0)."""
+    if coupling[1] == "jacobi" and H >= 5e-4:
+        pytest.xfail("a Jacobi master at H >= 0.5 ms: the force of the second step is announced before the "
+                     "contact has seen how the unseen spring slowed the striker in the first")
+    r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S)
     assert r["energy_error"] <= ROUNDING
 
 

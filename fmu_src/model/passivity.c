@@ -6,6 +6,14 @@
 
 #include "contact.h"
 
+/* The bodies' displacement over an interval of length H: Hermite's
+ * quadrature of their approach speed, whose rate a - F/m is known at both
+ * ends with the held force F the same there (so it cancels). */
+static double displacement(double H, double u_start, double u_end, double a_start, double a_end)
+{
+    return 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;
+}
+
 /* The energy one interval of length H creates that does not return: the
  * proxy's kinetic energy given up, plus the work its held acceleration a_start
  * does on the bodies' real path less that acceleration's own change, less
@@ -16,9 +24,7 @@
 double coupling_energy_created(double m, double H, double u0, double u1, double F_end, double u_start,
                                double u_end, double a_start, double a_end, double F)
 {
-    /* the bodies' displacement: Hermite's quadrature of their approach speed,
-     * whose rate a - F/m is known at both ends with F the same (it cancels) */
-    const double dx = 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;
+    const double dx = displacement(H, u_start, u_end, a_start, a_end);
     const double da = a_end - a_start;
     return m * (0.5 * (u0 - u1) * (u0 + u1) + a_start * (dx - da * H * H / 6.0)) - F * dx
            - F_end * da * H * H / 12.0;
