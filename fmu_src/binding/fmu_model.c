@@ -573,37 +573,40 @@ static double bodies_accel(const fmu_model *fm)
     return fm->params.g + other_accel(&fm->in);
 }
 
-/* A whole communication step [t, t + H] taken from the settled proxy
- * velocity u0: its interval in the energy account, and the correction to the force output for the bodies'
- * interval that has not yet begun to take it (this one under
- * Gauss-Seidel, the next under Jacobi). */
-static void account_step(fmu_model *fm, double t, double H, double u0)
+/* A whole communication step of length H taken from the proxy state
+ * *start, u0 its settled velocity: its interval in the energy account,
+ * and the correction to the force output for the bodies' interval that
+ * has not yet begun to take it (this one under Gauss-Seidel, the next
+ * under Jacobi). */
+static void account_step(fmu_model *fm, double H, const contact_state *start, double u0)
 {
     coupling_energy *e = &fm->energy, next;
     const contact_model *cm = &fm->model;
-    const double m = proxy_mass(&fm->in), a = bodies_accel(fm);
-    const int gauss_seidel = fm->coupling == COUPLING_GAUSS_SEIDEL;
-    coupling_energy_open(e, t, approach(&fm->in), a, gauss_seidel ? fm->F_avg : fm->announced + fm->correction);
-    e->u0 = u0;
-    e->u1 = settled_velocity(fm, cm->s.v);
-    e->F_end = cm->s.F;
-    if (gauss_seidel) {
-        fm->correction = coupling_energy_correction(e, m, H, e->created, fm->F_avg);
+    const prediction *p = &fm->next;
+    const double m = proxy_mass(&fm->in);
+    if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
+        coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->F_avg);
+        coupling_energy_proxy(e, cm, start, &cm->s, u0, cm->s.v);
+        fm->correction = coupling_energy_correction(e, m, !cm->s.in_contact);
         e->F += fm->correction;
         return;
     }
-    /* the next interval: the bodies' start extrapolated from this one's,
-     * the proxy's motion predicted from its own end (owing nothing then),
+    coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->announced + fm->correction);
+    coupling_energy_proxy(e, cm, start, &cm->s, u0, settled_velocity(fm, cm->s.v));
+    /* the next interval: the bodies' start predicted from this one's, the
+     * proxy's motion predicted from its own end (owing nothing then),
      * moved by the difference of the two starts */
-    next = *e;
-    coupling_energy_open(&next, t + H, coupling_energy_end_velocity(e, m, H, e->F), a + H * e->a_rate,
-                         fm->F_avg_next);
-    next.u0 = next.u;
-    next.u1 = next.u - e->u1
-              + (fm->next.valid ? fm->next.model.s.v : e->u1 + fm->step_H * (a - fm->F_avg_next / m));
-    next.F_end = fm->next.valid ? fm->next.model.s.F : fm->F_avg;
-    fm->correction = coupling_energy_correction(&next, m, fm->step_H, coupling_energy_predicted(e, m, H),
-                                                fm->F_avg_next);
+    next = coupling_energy_predicted(e, m);
+    coupling_energy_open(&next, fm->step_H, next.u, next.a, fm->F_avg_next);
+    if (p->valid) {
+        coupling_energy_proxy(&next, cm, &cm->s, &p->model.s, next.u, next.u - e->u1 + p->model.s.v);
+    } else {
+        next.u0 = next.u;
+        next.u1 = next.u + fm->step_H * (cm->accel - fm->F_avg_next / m);
+        next.F_end = fm->F_avg;
+        next.work = next.travel = 0.0;
+    }
+    fm->correction = coupling_energy_correction(&next, m, !(p->valid ? p->model.s.in_contact : cm->s.in_contact));
 }
 
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
@@ -644,7 +647,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->step_H = H;
     }
     if (!resume && proxy_striker(fm)) /* the inputs end the bodies' last interval */
-        coupling_energy_close(&fm->energy, proxy_mass(&fm->in), t, approach(&fm->in), bodies_accel(fm));
+        coupling_energy_close(&fm->energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
     t_start = cm->s.t;
     v_end = cm->s.v;
     contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
@@ -702,7 +705,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
     if (proxy_striker(fm) && !resume && !*event)
-        account_step(fm, t, H, u0);
+        account_step(fm, H, &before, u0);
     else { /* a step cut at an event: left out of the account */
         fm->energy.open = 0;
         fm->correction = 0.0;
@@ -770,8 +773,9 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.t), F(energy.u), F(energy.a),
-    F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), I(energy.open), F(correction),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag),
+    F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0),
+    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

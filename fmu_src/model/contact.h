@@ -197,43 +197,45 @@ typedef struct {
  * §17a), over the intervals of the communication steps: from the bodies'
  * approach speed u and acceleration a apart from the contact (g + a - a2)
  * at each interval's ends, the force F they take over it, and the proxy's
- * motion over it, the energy the coupling creates and does not return when
- * the contact's force does. */
+ * motion over it, the energy the coupling creates. */
 typedef struct {
-    double created;      /* over the closed intervals [J]; > 0: energy created */
-    double t, u, a;      /* the open interval: its start, the bodies' u and a there */
+    double created;      /* over the closed intervals, the part that does not return [J]; > 0: created */
+    double exact;        /* all of it: the proxy's work on the contact less the bodies' [J] */
+    double lag;          /* the proxy's travel less the bodies' displacement over them [m] */
+    double H, u, a;      /* the open interval: its length, the bodies' u and a at its start */
     double a_rate;       /* a's rate over the last closed interval (0 before one) */
     double a_unseen;     /* the bodies' mean acceleration over it that neither a nor F explains: a force
                             the inputs do not show (0 where a holds all the other forces) */
     double F;            /* the force the bodies take over the open interval [N] */
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
+    double work, travel; /* the proxy's work on the contact over it [J] and its travel [m] */
     int open;            /* an interval whose end the next inputs tell */
 } coupling_energy;
 
-/* What an interval of length H creates and does not return: the proxy
- * (mass m) from u0 to u1 ending at the force F_end, the bodies from
- * (u_start, a_start) to (u_end, a_end) under the force F. */
-double coupling_energy_created(double m, double H, double u0, double u1, double F_end, double u_start,
-                               double u_end, double a_start, double a_end, double F);
+/* Opens an interval of length H from the bodies' u and a under the force
+ * F; the proxy's motion over it, from *from to *to of the model *cm with
+ * u0 and u1 its settled velocities; closes it from the bodies' u and a at
+ * its end, adding what it created and taking a's rate and the unseen
+ * acceleration (nothing when none is open). */
+void coupling_energy_open(coupling_energy *e, double H, double u, double a, double F);
+void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const contact_state *from,
+                           const contact_state *to, double u0, double u1);
+void coupling_energy_close(coupling_energy *e, double m, double u, double a);
 
-/* Opens the interval at t from the bodies' u and a, under the force F (set
- * e->u0, e->u1, e->F_end as the proxy moves); closes it at t from
- * the bodies' u and a there, adding what it created and taking a's rate. */
-void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F);
-void coupling_energy_close(coupling_energy *e, double m, double t, double u, double a);
+/* The bodies' approach speed at the end of the open interval under the
+ * force F: from its start, a, a's rate and the unseen acceleration; the
+ * account with the open interval closed there (u and a: that end's). */
+double coupling_energy_end_velocity(const coupling_energy *e, double m, double F);
+coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 
-/* The bodies' approach speed at the end of the open interval of length H
- * under the force F, from its start, a, a's rate and the unseen
- * acceleration; e->created with that interval closed there. */
-double coupling_energy_end_velocity(const coupling_energy *e, double m, double H, double F);
-double coupling_energy_predicted(const coupling_energy *e, double m, double H);
-
-/* The change to the force F0 held over the open interval of length H that
- * brings `created` (the account before it) plus what it creates to 0 where
- * that is > 0: only ever taking more energy from the bodies; 0 otherwise.
- * The change is never larger than F0 itself (a force >= 0 stays so). */
-double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double F0);
+/* The change to the force F held over the open interval that brings the
+ * energy created that does not return, with the interval's own, to 0
+ * where it is > 0, and where the interval is the `last` with a force (the
+ * proxy ends it out of contact) also what the whole account will leave:
+ * only ever taking more energy from the bodies; 0 otherwise. Never larger
+ * than F itself (a force >= 0 stays so). */
+double coupling_energy_correction(const coupling_energy *e, double m, int last);
 
 /* The paper's h20 test (docs/model.md §1): the parameters, and the
  * striker's impact velocity v [m/s] and mass m [kg]. */

@@ -14,58 +14,66 @@ static double displacement(double H, double u_start, double u_end, double a_star
     return 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;
 }
 
-/* The energy one interval of length H creates that does not return: the
- * proxy's kinetic energy given up, plus the work its held acceleration a_start
- * does on the bodies' real path less that acceleration's own change, less
- * the work the bodies do on the contact (F held over their displacement),
+/* The energy the open interval creates and does not return, the bodies
+ * ending it at (u_end, a_end): the proxy's kinetic energy given up, plus
+ * the work its held acceleration does on the bodies' path less that
+ * acceleration's own change, less the work the bodies do on the contact,
  * less the work the change of a does against the force the contact holds
  * at the end. With a constant a, and the proxy's velocities those the held
  * force gives the bodies, the terms cancel exactly. */
-double coupling_energy_created(double m, double H, double u0, double u1, double F_end, double u_start,
-                               double u_end, double a_start, double a_end, double F)
+static double secular(const coupling_energy *e, double m, double u_end, double a_end)
 {
-    const double dx = displacement(H, u_start, u_end, a_start, a_end);
-    const double da = a_end - a_start;
-    return m * (0.5 * (u0 - u1) * (u0 + u1) + a_start * (dx - da * H * H / 6.0)) - F * dx
-           - F_end * da * H * H / 12.0;
+    const double H = e->H, dx = displacement(H, e->u, u_end, e->a, a_end), da = a_end - e->a;
+    return m * (0.5 * (e->u0 - e->u1) * (e->u0 + e->u1) + e->a * (dx - da * H * H / 6.0)) - e->F * dx
+           - e->F_end * da * H * H / 12.0;
 }
 
-double coupling_energy_end_velocity(const coupling_energy *e, double m, double H, double F)
+void coupling_energy_open(coupling_energy *e, double H, double u, double a, double F)
 {
-    return e->u + H * (e->a + e->a_unseen + 0.5 * H * e->a_rate - F / m);
-}
-
-/* What the open interval of length H creates with the force F held on the
- * bodies, their end predicted. */
-static double predicted_created(const coupling_energy *e, double m, double H, double F)
-{
-    return coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, coupling_energy_end_velocity(e, m, H, F), e->a,
-                                   e->a + H * e->a_rate, F);
-}
-
-void coupling_energy_open(coupling_energy *e, double t, double u, double a, double F)
-{
-    e->t = t;
+    e->H = H;
     e->u = u;
     e->a = a;
     e->F = F;
     e->open = 1;
 }
 
-void coupling_energy_close(coupling_energy *e, double m, double t, double u, double a)
+void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const contact_state *from,
+                           const contact_state *to, double u0, double u1)
 {
-    const double H = t - e->t;
-    if (e->open && H > 0.0) {
-        e->created += coupling_energy_created(m, H, e->u0, e->u1, e->F_end, e->u, u, e->a, a, e->F);
-        e->a_rate = (a - e->a) / H;
-        e->a_unseen = (u - e->u) / H + e->F / m - 0.5 * (e->a + a);
-    }
+    e->u0 = u0;
+    e->u1 = u1;
+    e->F_end = to->F;
+    e->travel = to->x1 + to->x2 - from->x1 - from->x2;
+    e->work = (0.5 * (from->v - to->v) * (from->v + to->v) + cm->accel * e->travel) / cm->inv_m;
+}
+
+void coupling_energy_close(coupling_energy *e, double m, double u, double a)
+{
+    double dx;
+    if (!e->open)
+        return;
+    dx = displacement(e->H, e->u, u, e->a, a);
+    e->created += secular(e, m, u, a);
+    e->exact += e->work - e->F * dx;
+    e->lag += e->travel - dx;
+    e->a_rate = (a - e->a) / e->H;
+    e->a_unseen = (u - e->u) / e->H + e->F / m - 0.5 * (e->a + a);
     e->open = 0;
 }
 
-double coupling_energy_predicted(const coupling_energy *e, double m, double H)
+double coupling_energy_end_velocity(const coupling_energy *e, double m, double F)
 {
-    return e->created + predicted_created(e, m, H, e->F);
+    return e->u + e->H * (e->a + e->a_unseen + 0.5 * e->H * e->a_rate - F / m);
+}
+
+coupling_energy coupling_energy_predicted(const coupling_energy *e, double m)
+{
+    coupling_energy next = *e;
+    const double u_end = coupling_energy_end_velocity(e, m, e->F), a_end = e->a + e->H * e->a_rate;
+    coupling_energy_close(&next, m, u_end, a_end); /* the rates it takes are e's again */
+    next.u = u_end;
+    next.a = a_end;
+    return next;
 }
 
 /* The smallest change d of the force, in the sign of g (the direction in
@@ -80,12 +88,25 @@ static double smallest_change(double E, double g, double c)
     return disc < 0.0 ? g / (2.0 * c) : 2.0 * E / (g + copysign(sqrt(disc), g));
 }
 
-/* c = H^2/(2m): the held force's work over the displacement it shortens;
- * X: the bodies' displacement without it. */
-double coupling_energy_correction(const coupling_energy *e, double m, double H, double created, double F0)
+/* Both energies are quadratic in the force: with F = F0 + d the bodies'
+ * displacement X - c F shortens by c d (c = H^2/(2m)). The account of all
+ * the energy created, less the held acceleration's work over the lag of
+ * the proxy's path behind the bodies' (which returns as the lag closes,
+ * and which a constant acceleration makes the whole of it), is the energy
+ * the coupling leaves once the contact is over: it counts at the last
+ * interval with a force, where the secular part alone may miss what a
+ * coarse step makes of the rest. */
+double coupling_energy_correction(const coupling_energy *e, double m, int last)
 {
-    const double c = 0.5 * H * H / m;
-    const double X = H * e->u + 0.5 * H * H * (e->a + e->a_unseen) + H * H * H * e->a_rate / 6.0;
-    const double d = smallest_change(created + predicted_created(e, m, H, F0), X + m * e->a * c - 2.0 * c * F0, c);
+    const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = e->a + H * e->a_rate;
+    const double X = H * e->u + 0.5 * H * H * (e->a + e->a_unseen) + H * H * H * e->a_rate / 6.0, dx = X - c * F0;
+    const double u_end = coupling_energy_end_velocity(e, m, F0);
+    double d = smallest_change(e->created + secular(e, m, u_end, a_end), X + m * e->a * c - 2.0 * c * F0, c);
+    if (last) {
+        const double left = e->exact + e->work - F0 * dx - m * a_end * (e->lag + e->travel - dx);
+        const double d_left = smallest_change(left, X + m * a_end * c - 2.0 * c * F0, c);
+        if (fabs(d_left) > fabs(d))
+            d = d_left;
+    }
     return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
 }
