@@ -605,6 +605,7 @@ static void account_step(fmu_model *fm, double H, const contact_state *start, do
         next.u1 = next.u + fm->step_H * (cm->accel - fm->F_avg_next / m);
         next.F_end = fm->F_avg;
         next.work = next.travel = 0.0;
+        next.flight = 0;
     }
     fm->correction = coupling_energy_correction(&next, m, !(p->valid ? p->model.s.in_contact : cm->s.in_contact));
 }
@@ -775,7 +776,7 @@ static const state_field state_fields[] = {
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag),
     F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0),
-    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), I(energy.open), F(correction),
+    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), I(energy.flight), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -210,6 +210,7 @@ typedef struct {
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
     double work, travel; /* the proxy's work on the contact over it [J] and its travel [m] */
+    int flight;          /* the proxy flew through it, out of contact */
     int open;            /* an interval whose end the next inputs tell */
 } coupling_energy;
 

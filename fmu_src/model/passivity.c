@@ -45,6 +45,7 @@ void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const co
     e->F_end = to->F;
     e->travel = to->x1 + to->x2 - from->x1 - from->x2;
     e->work = (0.5 * (from->v - to->v) * (from->v + to->v) + cm->accel * e->travel) / cm->inv_m;
+    e->flight = !from->in_contact && !to->in_contact && to->impacts == from->impacts;
 }
 
 void coupling_energy_close(coupling_energy *e, double m, double u, double a)
@@ -55,7 +56,8 @@ void coupling_energy_close(coupling_energy *e, double m, double u, double a)
     dx = displacement(e->H, e->u, u, e->a, a);
     e->created += secular(e, m, u, a);
     e->exact += e->work - e->F * dx;
-    e->lag += e->travel - dx;
+    /* the lag counts from where a force first acts between proxy and bodies */
+    e->lag = e->flight && e->F == 0.0 ? 0.0 : e->lag + e->travel - dx;
     e->a_rate = (a - e->a) / e->H;
     e->a_unseen = (u - e->u) / e->H + e->F / m - 0.5 * (e->a + a);
     e->open = 0;
