@@ -51,7 +51,7 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
-    coupling_energy energy; /* a proxy striker's energy account (docs/model.md §17a) */
+    coupling_energy energy; /* a proxy striker's energy account (docs/model.md §17) */
     double correction;    /* what the account adds to the force output for the bodies' next interval */
     contact_model model;
     prediction next;
@@ -403,6 +403,7 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->F_avg_next = fm->model.s.F;
     fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
     memset(&fm->energy, 0, sizeof fm->energy);
+    fm->energy.tracked = 1;
     fm->correction = 0.0;
     fm->predicted = fm->computed = 0;
     fm->next.valid = 0;
@@ -560,13 +561,6 @@ static int proxy_striker(const fmu_model *fm)
     return fm->params.scene == CONTACT_SCENE_DRIVEN && fm->in.m > 0.0;
 }
 
-/* The proxy's velocity with the impulse not yet passed to the bodies: the
- * bodies' approach speed once they have it. */
-static double settled_velocity(const fmu_model *fm, double v)
-{
-    return fm->coupling == COUPLING_JACOBI ? v + fm->owed / proxy_mass(&fm->in) : v;
-}
-
 /* The bodies' approach acceleration apart from the contact. */
 static double bodies_accel(const fmu_model *fm)
 {
@@ -574,11 +568,11 @@ static double bodies_accel(const fmu_model *fm)
 }
 
 /* A whole communication step of length H taken from the proxy state
- * *start, u0 its settled velocity: its interval in the energy account,
- * and the correction to the force output for the bodies' interval that
- * has not yet begun to take it (this one under Gauss-Seidel, the next
- * under Jacobi). */
-static void account_step(fmu_model *fm, double H, const contact_state *start, double u0)
+ * *start with the impulse J, the impulse owed before it `owed`: its
+ * interval in the energy account, and the correction to the force output
+ * for the bodies' interval that has not yet begun to take it (this one
+ * under Gauss-Seidel, the next under Jacobi). */
+static void account_step(fmu_model *fm, double H, const contact_state *start, double J, double owed)
 {
     coupling_energy *e = &fm->energy, next;
     const contact_model *cm = &fm->model;
@@ -586,27 +580,22 @@ static void account_step(fmu_model *fm, double H, const contact_state *start, do
     const double m = proxy_mass(&fm->in);
     if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
         coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->F_avg);
-        coupling_energy_proxy(e, cm, start, &cm->s, u0, cm->s.v);
+        coupling_energy_proxy(e, cm, start, &cm->s, J, 0.0, 0.0);
         fm->correction = coupling_energy_correction(e, m, !cm->s.in_contact);
         e->F += fm->correction;
         return;
     }
     coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->announced + fm->correction);
-    coupling_energy_proxy(e, cm, start, &cm->s, u0, settled_velocity(fm, cm->s.v));
+    coupling_energy_proxy(e, cm, start, &cm->s, J, owed / m, fm->owed / m);
     /* the next interval: the bodies' start predicted from this one's, the
      * proxy's motion predicted from its own end (owing nothing then),
      * moved by the difference of the two starts */
     next = coupling_energy_predicted(e, m);
     coupling_energy_open(&next, fm->step_H, next.u, next.a, fm->F_avg_next);
-    if (p->valid) {
-        coupling_energy_proxy(&next, cm, &cm->s, &p->model.s, next.u, next.u - e->u1 + p->model.s.v);
-    } else {
-        next.u0 = next.u;
-        next.u1 = next.u + fm->step_H * (cm->accel - fm->F_avg_next / m);
-        next.F_end = fm->F_avg;
-        next.work = next.travel = 0.0;
-        next.flight = 0;
-    }
+    coupling_energy_proxy(&next, cm, &cm->s, p->valid ? &p->model.s : &cm->s, fm->F_avg_next * fm->step_H - fm->owed,
+                          fm->owed / m, 0.0);
+    next.u1 += next.u - next.u0;
+    next.u0 = next.u;
     fm->correction = coupling_energy_correction(&next, m, !(p->valid ? p->model.s.in_contact : cm->s.in_contact));
 }
 
@@ -625,7 +614,6 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
     const coupling_energy energy = fm->energy;
     const double correction = fm->correction;
-    double u0;
     int from_prediction, other_coupling;
     *event = 0;
     /* A refused step changes nothing, so the checks come first: a uniform
@@ -654,7 +642,6 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
                   fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
     before = cm->s;
-    u0 = proxy_striker(fm) ? settled_velocity(fm, cm->s.v) : 0.0;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
     if (from_prediction) {
@@ -706,9 +693,9 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
     if (proxy_striker(fm) && !resume && !*event)
-        account_step(fm, H, &before, u0);
+        account_step(fm, H, &before, impulse, owed);
     else { /* a step cut at an event: left out of the account */
-        fm->energy.open = 0;
+        fm->energy.open = fm->energy.tracked = 0;
         fm->correction = 0.0;
     }
     overflow = nonfinite_output(fm);
@@ -774,9 +761,9 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag), I(energy.tracked), F(energy.rounding),
     F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0),
-    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), I(energy.flight), I(energy.open), F(correction),
+    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), F(energy.scale), I(energy.flight), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

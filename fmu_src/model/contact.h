@@ -194,14 +194,17 @@ typedef struct {
 } contact_model;
 
 /* The energy account of a proxy striker's coupling (passivity.c, docs/model.md
- * §17a), over the intervals of the communication steps: from the bodies'
+ * §17), over the intervals of the communication steps: from the bodies'
  * approach speed u and acceleration a apart from the contact (g + a - a2)
  * at each interval's ends, the force F they take over it, and the proxy's
  * motion over it, the energy the coupling creates. */
 typedef struct {
     double created;      /* over the closed intervals, the part that does not return [J]; > 0: created */
-    double exact;        /* all of it: the proxy's work on the contact less the bodies' [J] */
-    double lag;          /* the proxy's travel less the bodies' displacement over them [m] */
+    double exact;        /* all of it: the proxy's work on the contact less the bodies' [J], */
+    double lag;          /* and the proxy's travel less the bodies' displacement [m], since the last
+                            interval without a force, where the proxy flew */
+    int tracked;         /* whether every interval since then is in them (a step cut at an event is not) */
+    double rounding;     /* the sizes of the terms the account added [J] (ACCOUNT_ROUNDING of it is rounding) */
     double H, u, a;      /* the open interval: its length, the bodies' u and a at its start */
     double a_rate;       /* a's rate over the last closed interval (0 before one) */
     double a_unseen;     /* the bodies' mean acceleration over it that neither a nor F explains: a force
@@ -210,18 +213,20 @@ typedef struct {
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
     double work, travel; /* the proxy's work on the contact over it [J] and its travel [m] */
+    double scale;        /* the size of its terms [J] */
     int flight;          /* the proxy flew through it, out of contact */
     int open;            /* an interval whose end the next inputs tell */
 } coupling_energy;
 
 /* Opens an interval of length H from the bodies' u and a under the force
  * F; the proxy's motion over it, from *from to *to of the model *cm with
- * u0 and u1 its settled velocities; closes it from the bodies' u and a at
- * its end, adding what it created and taking a's rate and the unseen
- * acceleration (nothing when none is open). */
+ * the impulse J, w0 and w1 the velocities the impulse owed to the bodies
+ * at its start and end gives them (0 but under Jacobi); closes it from the
+ * bodies' u and a at its end, adding what it created and taking a's rate
+ * and the unseen acceleration (nothing when none is open). */
 void coupling_energy_open(coupling_energy *e, double H, double u, double a, double F);
 void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const contact_state *from,
-                           const contact_state *to, double u0, double u1);
+                           const contact_state *to, double J, double w0, double w1);
 void coupling_energy_close(coupling_energy *e, double m, double u, double a);
 
 /* The bodies' approach speed at the end of the open interval under the
@@ -233,8 +238,8 @@ coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 /* The change to the force F held over the open interval that brings the
  * energy created that does not return, with the interval's own, to 0
  * where it is > 0, and where the interval is the `last` with a force (the
- * proxy ends it out of contact) also what the whole account will leave:
- * only ever taking more energy from the bodies; 0 otherwise. Never larger
+ * proxy ends it out of contact) also what the whole account will leave (where
+ * and `tracked`): only ever taking more energy from the bodies; 0 otherwise. Never larger
  * than F itself (a force >= 0 stays so). */
 double coupling_energy_correction(const coupling_energy *e, double m, int last);
 

@@ -1,7 +1,8 @@
 /* The energy account of a proxy striker's coupling and the correction that
- * keeps the coupling from creating energy (docs/model.md §17a): once per
+ * keeps the coupling from creating energy (docs/model.md §17): once per
  * communication step, from the inputs at its ends and the proxy's motion
  * over it; nothing in the internal steps. */
+#include <float.h>
 #include <math.h>
 
 #include "contact.h"
@@ -38,13 +39,18 @@ void coupling_energy_open(coupling_energy *e, double H, double u, double a, doub
 }
 
 void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const contact_state *from,
-                           const contact_state *to, double u0, double u1)
+                           const contact_state *to, double J, double w0, double w1)
 {
-    e->u0 = u0;
-    e->u1 = u1;
+    /* the end velocity the impulse gives (a multistep scheme's own may
+     * differ from it by its truncation error, which is no energy the
+     * bodies see) */
+    const double v1 = from->v + e->H * cm->accel - J * cm->inv_m;
+    e->u0 = from->v + w0;
+    e->u1 = v1 + w1;
     e->F_end = to->F;
     e->travel = to->x1 + to->x2 - from->x1 - from->x2;
-    e->work = (0.5 * (from->v - to->v) * (from->v + to->v) + cm->accel * e->travel) / cm->inv_m;
+    e->work = (0.5 * (from->v - v1) * (from->v + v1) + cm->accel * e->travel) / cm->inv_m;
+    e->scale = 0.5 * (e->u0 * e->u0 + e->u1 * e->u1) / cm->inv_m + fabs(e->work);
     e->flight = !from->in_contact && !to->in_contact && to->impacts == from->impacts;
 }
 
@@ -56,8 +62,12 @@ void coupling_energy_close(coupling_energy *e, double m, double u, double a)
     dx = displacement(e->H, e->u, u, e->a, a);
     e->created += secular(e, m, u, a);
     e->exact += e->work - e->F * dx;
-    /* the lag counts from where a force first acts between proxy and bodies */
-    e->lag = e->flight && e->F == 0.0 ? 0.0 : e->lag + e->travel - dx;
+    e->lag += e->travel - dx;
+    if (e->flight && e->F == 0.0) { /* nothing between proxy and bodies: the whole account starts again */
+        e->exact = e->lag = 0.0;
+        e->tracked = 1;
+    }
+    e->rounding += e->scale + fabs(e->F * dx);
     e->a_rate = (a - e->a) / e->H;
     e->a_unseen = (u - e->u) / e->H + e->F / m - 0.5 * (e->a + a);
     e->open = 0;
@@ -90,6 +100,13 @@ static double smallest_change(double E, double g, double c)
     return disc < 0.0 ? g / (2.0 * c) : 2.0 * E / (g + copysign(sqrt(disc), g));
 }
 
+/* The account adds terms of the size of the kinetic energies and works of
+ * each interval (`rounding` sums them), each rounded to a few ulps, and
+ * the bodies' velocities drift from the proxy's by an ulp a step: an
+ * energy within ACCOUNT_ROUNDING of that sum cannot be told from 0 (two
+ * free bodies, a constant acceleration), and is left alone. */
+#define ACCOUNT_ROUNDING (16.0 * DBL_EPSILON)
+
 /* Both energies are quadratic in the force: with F = F0 + d the bodies'
  * displacement X - c F shortens by c d (c = H^2/(2m)). The account of all
  * the energy created, less the held acceleration's work over the lag of
@@ -103,9 +120,10 @@ double coupling_energy_correction(const coupling_energy *e, double m, int last)
     const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = e->a + H * e->a_rate;
     const double X = H * e->u + 0.5 * H * H * (e->a + e->a_unseen) + H * H * H * e->a_rate / 6.0, dx = X - c * F0;
     const double u_end = coupling_energy_end_velocity(e, m, F0);
-    double d = smallest_change(e->created + secular(e, m, u_end, a_end), X + m * e->a * c - 2.0 * c * F0, c);
-    if (last) {
-        const double left = e->exact + e->work - F0 * dx - m * a_end * (e->lag + e->travel - dx);
+    const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * dx));
+    double d = smallest_change(e->created + secular(e, m, u_end, a_end) - noise, X + m * e->a * c - 2.0 * c * F0, c);
+    if (last && e->tracked) {
+        const double left = e->exact + e->work - F0 * dx - m * a_end * (e->lag + e->travel - dx) - noise;
         const double d_left = smallest_change(left, X + m * a_end * c - 2.0 * c * F0, c);
         if (fabs(d_left) > fabs(d))
             d = d_left;
