@@ -237,10 +237,11 @@ coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 
 /* The change to the force F held over the open interval that brings the
  * energy created that does not return, with the interval's own, to 0
- * where it is > 0, and where the interval is the `last` with a force (the
- * proxy ends it out of contact) also what the whole account will leave (where
- * and `tracked`): only ever taking more energy from the bodies; 0 otherwise. Never larger
- * than F itself (a force >= 0 stays so). */
+ * where it is > 0 beyond the account's rounding; where the interval is
+ * the `last` with a force (the proxy ends it out of contact) and the
+ * whole account is `tracked`, also what that account will leave. Only
+ * ever taking more energy from the bodies; 0 otherwise; never larger than
+ * F itself (a force >= 0 stays so). */
 double coupling_energy_correction(const coupling_energy *e, double m, int last);
 
 /* The paper's h20 test (docs/model.md §1): the parameters, and the
