@@ -227,7 +227,7 @@ STEPS = (1e-6, 1e-5, 1e-4, 2e-4, 5e-4, 1e-3)  # the report's range, 1 us to 1 ms
 @pytest.mark.parametrize("H", STEPS)
 @pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
 def test_a_spring_fed_as_a_creates_no_energy(coupling, H):
-    """The coupling's energy account (docs/model.md §17a) corrects the force
+    """The coupling's energy account (docs/model.md §17) corrects the force
     the bodies take so that the energy it creates stays at or below 0: the
     striker's kinetic and spring energy plus the contact's E_diss end below
     the start (main created (k_s / m) (H^2 / 4) E_diss, +2.2e-6 E0 at

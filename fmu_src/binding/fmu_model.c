@@ -761,9 +761,10 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag), I(energy.tracked), F(energy.rounding),
-    F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0),
-    F(energy.u1), F(energy.F_end), F(energy.work), F(energy.travel), F(energy.scale), I(energy.flight), I(energy.open), F(correction),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag),
+    I(energy.tracked), F(energy.rounding), F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate),
+    F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), F(energy.work),
+    F(energy.travel), F(energy.scale), I(energy.flight), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -118,10 +118,10 @@ static double smallest_change(double E, double g, double c)
 double coupling_energy_correction(const coupling_energy *e, double m, int last)
 {
     const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = e->a + H * e->a_rate;
-    const double X = H * e->u + 0.5 * H * H * (e->a + e->a_unseen) + H * H * H * e->a_rate / 6.0, dx = X - c * F0;
-    const double u_end = coupling_energy_end_velocity(e, m, F0);
+    const double X = displacement(H, e->u, coupling_energy_end_velocity(e, m, 0.0), e->a, a_end), dx = X - c * F0;
     const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * dx));
-    double d = smallest_change(e->created + secular(e, m, u_end, a_end) - noise, X + m * e->a * c - 2.0 * c * F0, c);
+    const double created = e->created + secular(e, m, coupling_energy_end_velocity(e, m, F0), a_end);
+    double d = smallest_change(created - noise, X + m * e->a * c - 2.0 * c * F0, c);
     if (last && e->tracked) {
         const double left = e->exact + e->work - F0 * dx - m * a_end * (e->lag + e->travel - dx) - noise;
         const double d_left = smallest_change(left, X + m * a_end * c - 2.0 * c * F0, c);

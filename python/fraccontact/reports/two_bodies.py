@@ -46,7 +46,7 @@ The proxy striker inside the step moves at the approach speed `v − v2` with th
 
 A body touched by several contacts: its `a` for one contact includes the others' forces at the step's start (their `F` over its mass).
 
-`F_avg` and `F_avg_next` include the coupling's energy correction (docs/model.md §17a): from `v`, `v2`, `a`, `a2` at both ends of each step the FMU knows the bodies' real displacement, hence the work they did on the contact against the work its proxy absorbed, and it adds to the force it outputs whatever keeps the energy the coupling has created at or below zero. It is zero for two free bodies and for constant accelerations.
+`F_avg` and `F_avg_next` include the coupling's energy correction (docs/model.md §17): from `v`, `v2`, `a`, `a2` at both ends of each step the FMU knows the bodies' real displacement, hence the work they did on the contact against the work its proxy absorbed, and it adds to the force it outputs whatever keeps the energy the coupling has created at or below zero. It is zero for two free bodies and for constant accelerations.
 """
 
 
@@ -105,7 +105,7 @@ def write(path, free_ref, free_rows, spring_ref, table):
             f"F_peak = {spring_ref['F_peak']:.6g} N, eps = {spring_ref['eps']:.6g}). Blind: the contact knows nothing "
             "of the spring; fed: the master feeds `a = −k_s x / m` at each step's start. Orders between neighbouring "
             "steps in brackets. The energy error includes the spring's energy; > 0 is energy created. The FMU's "
-            "energy account (docs/model.md §17a) corrects the force each step so that the coupling creates none; the "
+            "energy account (docs/model.md §17) corrects the force each step so that the coupling creates none; the "
             "last column is the closed form of what the fed coupling created without it (on main), "
             "(k_s / m) (H² / 4) E_diss / E0: the proxy holds the spring's acceleration over the step (its path runs "
             "ahead by k_s v H³ / (6 m)) and the master holds the contact force on a striker the spring slows "
