@@ -205,7 +205,7 @@ def test_a_spring_fed_as_a_is_second_order(spring, coupling):
     its acceleration fed as a at each step's start cuts the coupling's error
     from first order in H to second (measured at 1e-5 s: F_peak 2.6e-4 ->
     6.4e-7 Gauss-Seidel, 2.1e-6 Jacobi; eps 2.2e-4 -> 1.1e-6 and 2.9e-6;
-    orders 1.9 to 2.4 over 1e-6 to 1e-4 s)."""
+    orders 1.9 to 2.9 over 1e-6 to 1e-4 s)."""
     blind, fed = {}, {}
     for H in (1e-6, 1e-5, 1e-4):
         blind[H] = errors(cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S), spring)

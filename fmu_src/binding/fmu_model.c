@@ -403,7 +403,6 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->F_avg_next = fm->model.s.F;
     fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
     memset(&fm->energy, 0, sizeof fm->energy);
-    fm->energy.tracked = 1;
     fm->correction = 0.0;
     fm->predicted = fm->computed = 0;
     fm->next.valid = 0;
@@ -581,22 +580,21 @@ static void account_step(fmu_model *fm, double H, const contact_state *start, do
     if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
         coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->F_avg);
         coupling_energy_proxy(e, cm, start, &cm->s, J, 0.0, 0.0);
-        fm->correction = coupling_energy_correction(e, m, !cm->s.in_contact);
+        fm->correction = coupling_energy_correction(e, m);
         e->F += fm->correction;
         return;
     }
     coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->announced + fm->correction);
     coupling_energy_proxy(e, cm, start, &cm->s, J, owed / m, fm->owed / m);
     /* the next interval: the bodies' start predicted from this one's, the
-     * proxy's motion predicted from its own end (owing nothing then),
-     * moved by the difference of the two starts */
+     * proxy's motion from its own end (owing nothing then), moved to it */
     next = coupling_energy_predicted(e, m);
     coupling_energy_open(&next, fm->step_H, next.u, next.a, fm->F_avg_next);
     coupling_energy_proxy(&next, cm, &cm->s, p->valid ? &p->model.s : &cm->s, fm->F_avg_next * fm->step_H - fm->owed,
                           fm->owed / m, 0.0);
     next.u1 += next.u - next.u0;
     next.u0 = next.u;
-    fm->correction = coupling_energy_correction(&next, m, !(p->valid ? p->model.s.in_contact : cm->s.in_contact));
+    fm->correction = coupling_energy_correction(&next, m);
 }
 
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
@@ -695,7 +693,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     if (proxy_striker(fm) && !resume && !*event)
         account_step(fm, H, &before, impulse, owed);
     else { /* a step cut at an event: left out of the account */
-        fm->energy.open = fm->energy.tracked = 0;
+        fm->energy.open = 0;
         fm->correction = 0.0;
     }
     overflow = nonfinite_output(fm);
@@ -761,10 +759,9 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.exact), F(energy.lag),
-    I(energy.tracked), F(energy.rounding), F(energy.H), F(energy.u), F(energy.a), F(energy.a_rate),
-    F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1), F(energy.F_end), F(energy.work),
-    F(energy.travel), F(energy.scale), I(energy.flight), I(energy.open), F(correction),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.rounding), F(energy.H),
+    F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1),
+    F(energy.F_end), F(energy.scale), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -197,13 +197,10 @@ typedef struct {
  * §17), over the intervals of the communication steps: from the bodies'
  * approach speed u and acceleration a apart from the contact (g + a - a2)
  * at each interval's ends, the force F they take over it, and the proxy's
- * motion over it, the energy the coupling creates. */
+ * motion over it, the energy the coupling creates and does not return when
+ * the contact's force does. */
 typedef struct {
-    double created;      /* over the closed intervals, the part that does not return [J]; > 0: created */
-    double exact;        /* all of it: the proxy's work on the contact less the bodies' [J], */
-    double lag;          /* and the proxy's travel less the bodies' displacement [m], since the last
-                            interval without a force, where the proxy flew */
-    int tracked;         /* whether every interval since then is in them (a step cut at an event is not) */
+    double created;      /* over the closed intervals [J]; > 0: energy created */
     double rounding;     /* the sizes of the terms the account added [J] (ACCOUNT_ROUNDING of it is rounding) */
     double H, u, a;      /* the open interval: its length, the bodies' u and a at its start */
     double a_rate;       /* a's rate over the last closed interval (0 before one) */
@@ -212,9 +209,7 @@ typedef struct {
     double F;            /* the force the bodies take over the open interval [N] */
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
-    double work, travel; /* the proxy's work on the contact over it [J] and its travel [m] */
     double scale;        /* the size of its terms [J] */
-    int flight;          /* the proxy flew through it, out of contact */
     int open;            /* an interval whose end the next inputs tell */
 } coupling_energy;
 
@@ -236,13 +231,10 @@ double coupling_energy_end_velocity(const coupling_energy *e, double m, double F
 coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 
 /* The change to the force F held over the open interval that brings the
- * energy created that does not return, with the interval's own, to 0
- * where it is > 0 beyond the account's rounding; where the interval is
- * the `last` with a force (the proxy ends it out of contact) and the
- * whole account is `tracked`, also what that account will leave. Only
- * ever taking more energy from the bodies; 0 otherwise; never larger than
- * F itself (a force >= 0 stays so). */
-double coupling_energy_correction(const coupling_energy *e, double m, int last);
+ * energy created, with the interval's own, to 0 where it is > 0 beyond
+ * the account's rounding: only ever taking more energy from the bodies; 0
+ * otherwise; never larger than F itself (a force >= 0 stays so). */
+double coupling_energy_correction(const coupling_energy *e, double m);
 
 /* The paper's h20 test (docs/model.md §1): the parameters, and the
  * striker's impact velocity v [m/s] and mass m [kg]. */

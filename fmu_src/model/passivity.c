@@ -48,10 +48,7 @@ void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const co
     e->u0 = from->v + w0;
     e->u1 = v1 + w1;
     e->F_end = to->F;
-    e->travel = to->x1 + to->x2 - from->x1 - from->x2;
-    e->work = (0.5 * (from->v - v1) * (from->v + v1) + cm->accel * e->travel) / cm->inv_m;
-    e->scale = 0.5 * (e->u0 * e->u0 + e->u1 * e->u1) / cm->inv_m + fabs(e->work);
-    e->flight = !from->in_contact && !to->in_contact && to->impacts == from->impacts;
+    e->scale = 0.5 * (e->u0 * e->u0 + e->u1 * e->u1) / cm->inv_m;
 }
 
 void coupling_energy_close(coupling_energy *e, double m, double u, double a)
@@ -61,12 +58,6 @@ void coupling_energy_close(coupling_energy *e, double m, double u, double a)
         return;
     dx = displacement(e->H, e->u, u, e->a, a);
     e->created += secular(e, m, u, a);
-    e->exact += e->work - e->F * dx;
-    e->lag += e->travel - dx;
-    if (e->flight && e->F == 0.0) { /* nothing between proxy and bodies: the whole account starts again */
-        e->exact = e->lag = 0.0;
-        e->tracked = 1;
-    }
     e->rounding += e->scale + fabs(e->F * dx);
     e->a_rate = (a - e->a) / e->H;
     e->a_unseen = (u - e->u) / e->H + e->F / m - 0.5 * (e->a + a);
@@ -107,26 +98,14 @@ static double smallest_change(double E, double g, double c)
  * free bodies, a constant acceleration), and is left alone. */
 #define ACCOUNT_ROUNDING (16.0 * DBL_EPSILON)
 
-/* Both energies are quadratic in the force: with F = F0 + d the bodies'
- * displacement X - c F shortens by c d (c = H^2/(2m)). The account of all
- * the energy created, less the held acceleration's work over the lag of
- * the proxy's path behind the bodies' (which returns as the lag closes,
- * and which a constant acceleration makes the whole of it), is the energy
- * the coupling leaves once the contact is over: it counts at the last
- * interval with a force, where the secular part alone may miss what a
- * coarse step makes of the rest. */
-double coupling_energy_correction(const coupling_energy *e, double m, int last)
+/* The energy is quadratic in the force: with F = F0 + d the bodies'
+ * displacement X - c F shortens by c d (c = H^2/(2m)). */
+double coupling_energy_correction(const coupling_energy *e, double m)
 {
     const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = e->a + H * e->a_rate;
-    const double X = displacement(H, e->u, coupling_energy_end_velocity(e, m, 0.0), e->a, a_end), dx = X - c * F0;
-    const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * dx));
+    const double X = displacement(H, e->u, coupling_energy_end_velocity(e, m, 0.0), e->a, a_end);
+    const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * (X - c * F0)));
     const double created = e->created + secular(e, m, coupling_energy_end_velocity(e, m, F0), a_end);
-    double d = smallest_change(created - noise, X + m * e->a * c - 2.0 * c * F0, c);
-    if (last && e->tracked) {
-        const double left = e->exact + e->work - F0 * dx - m * a_end * (e->lag + e->travel - dx) - noise;
-        const double d_left = smallest_change(left, X + m * a_end * c - 2.0 * c * F0, c);
-        if (fabs(d_left) > fabs(d))
-            d = d_left;
-    }
+    const double d = smallest_change(created - noise, X + m * e->a * c - 2.0 * c * F0, c);
     return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
 }

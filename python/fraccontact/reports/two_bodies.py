@@ -144,9 +144,9 @@ def write(path, free_ref, free_rows, spring_ref, table):
             f"lasts {spring_ref['t_contact'] * 1e3:.2g} ms) every coupling is coarse. Runs that still create "
             f"energy (beyond {ROUNDING:g} E0): " + ("; ".join(created) if created else "none") + ". A Jacobi master "
             "announces each step's force before the step, from the inputs of the step before: where the impact "
-            "starts at t = 0 and lasts about one step, the force of the second step is fixed before the contact has "
-            "seen how the spring slowed the striker in the first, and no later force (>= 0, on separating bodies) "
-            "can take the energy back.", ""]
+            "starts at t = 0 and lasts one step or a few, the force of the second step is fixed before the contact "
+            "has seen how the spring slowed the striker in the first, and no later force (>= 0, on separating "
+            "bodies) can take the energy back.", ""]
     atomic.write_text(path, "\n".join(out))
 
 
