@@ -204,7 +204,8 @@ def test_a_spring_fed_as_a_is_second_order(spring, coupling):
     """The spring k_s on the striker, which no contact parameter describes:
     its acceleration fed as a at each step's start cuts the coupling's error
     from first order in H to second (measured at 1e-5 s: F_peak 2.6e-4 ->
-    2.1e-6, eps 2.2e-4 -> 1.7e-6; orders 1.9 to 2.4 over 1e-6 to 1e-4 s)."""
+    6.4e-7 Gauss-Seidel, 2.1e-6 Jacobi; eps 2.2e-4 -> 1.1e-6 and 2.9e-6;
+    orders 1.9 to 2.9 over 1e-6 to 1e-4 s)."""
     blind, fed = {}, {}
     for H in (1e-6, 1e-5, 1e-4):
         blind[H] = errors(cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S), spring)
@@ -220,25 +221,54 @@ def test_a_spring_fed_as_a_is_second_order(spring, coupling):
     assert 0.9 <= math.log10(blind[1e-5][0] / blind[1e-6][0]) <= 1.1
 
 
+STEPS = (1e-6, 1e-5, 1e-4, 2e-4, 5e-4, 1e-3)  # the report's range, 1 us to 1 ms
+
+
+@pytest.mark.parametrize("H", STEPS)
 @pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
-def test_the_energy_a_spring_creates_falls_to_the_force_hold_s_share(spring, coupling):
-    """With a fed, the energy still created is second order and of a closed
-    form: the proxy holds the spring's acceleration over the step (its path
-    runs ahead by k_s v H^3 / (6 m) a step) and the master holds the contact
-    force on the striker whose spring slows it (k_s v H^3 / (12 m)): in all
-    (k_s / m) (H^2 / 4) E_diss / E0 (measured within 3 % at 2e-6 and 1e-5 s;
-    the rest is the FMU's own dissipation error, about 3e-9 of E0). Fed or
-    not, no more than without a at any H from 1 us to 1 ms."""
-    E0 = 0.5 * M * V0 ** 2  # the impact's energy, the energy error's unit
-    for H in (2e-6, 1e-5):
-        r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S, feed_a=True)
-        predicted = K_S / M * H * H / 4 * r["E_diss"] / E0
-        # 5 %: the measured 3 % and the floor's 3e-9 against 8.5e-8 at 2e-6 s
-        assert r["energy_error"] == pytest.approx(predicted, rel=0.05, abs=3e-9)
-    for H in (1e-6, 1e-5, 1e-4, 1e-3):
-        fed = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S, feed_a=True)["energy_error"]
-        blind = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S)["energy_error"]
-        assert fed <= blind, H
+def test_a_spring_fed_as_a_creates_no_energy(coupling, H):
+    """The coupling's energy account (docs/model.md §17) corrects the force
+    the bodies take so that the energy it creates stays at or below 0: the
+    striker's kinetic and spring energy plus the contact's E_diss end below
+    the start (main created (k_s / m) (H^2 / 4) E_diss, +2.2e-6 E0 at
+    1e-5 s). Measured -1.4e-8 E0 at 1 us to -1.1e-2 at 0.5 ms. ROUNDING:
+    the energies' rounding over a run, far below the FMU's own dissipation
+    (about -1e-9 E0 at these H), so only a coupling that creates energy
+    fails."""
+    if coupling[1] == "jacobi" and H == 1e-3:
+        pytest.xfail("a Jacobi master at H = 1 ms: the impact (1.3 ms) starts at t = 0 and the force of the "
+                     "second step is announced before the contact has seen a second value of a")
+    r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S, feed_a=True)
+    assert r["energy_error"] <= ROUNDING
+
+
+@pytest.mark.parametrize("H", STEPS)
+@pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
+def test_a_spring_the_contact_does_not_see_creates_no_energy(coupling, H):
+    """Blind (a not fed), the account still sees the bodies' velocities at
+    both ends of each step, and the energy the unseen spring makes the
+    coupling create (first order in H on main: +7.8e-4 E0 at 1e-5 s) is
+    taken back (measured -9.9e-9 to -9.8e-3 E0)."""
+    if coupling[1] == "jacobi" and H >= 5e-4:
+        pytest.xfail("a Jacobi master at H >= 0.5 ms: the force of the second step is announced before the "
+                     "contact has seen how the unseen spring slowed the striker in the first")
+    r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S)
+    assert r["energy_error"] <= ROUNDING
+
+
+@pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
+def test_the_energy_correction_keeps_the_spring_case_within_its_second_order_error(spring, coupling):
+    """The correction takes energy from the bodies only where the coupling
+    would create it, by a force change of the size of that energy over the
+    step's displacement: second order in H, so F_peak and eps stay within
+    the fed coupling's second-order error at 1e-5 s (measured: F_peak
+    6.4e-7 Gauss-Seidel, 2.1e-6 Jacobi; eps 1.1e-6 and 2.9e-6), far below
+    the blind coupling's 2.6e-4 and 2.2e-4."""
+    r = cosimulate(CONTACT, STRIKER, 1e-5, *coupling, k_s=K_S, feed_a=True)
+    # rel 5e-6: the larger measured F_peak error (2.1e-6) and room for the FMU's own 1e-9; 50 times below blind
+    assert r["F_peak"] == pytest.approx(spring["F_peak"], rel=5e-6, abs=0)
+    # abs 6e-6: the larger measured eps error (2.9e-6) twice over; 35 times below blind
+    assert r["eps_contact"] == pytest.approx(spring["eps"], rel=0, abs=6e-6)
 
 
 # ------------------------------------------------------------- bad input

@@ -51,6 +51,8 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
+    coupling_energy energy; /* a proxy striker's energy account (docs/model.md §17) */
+    double correction;    /* what the account adds to the force output for the bodies' next interval */
     contact_model model;
     prediction next;
     fmu_reporter log;
@@ -262,8 +264,9 @@ static double real_output(const fmu_model *fm, unsigned vr)
     const contact_model *cm = &fm->model;
     switch (vr) {
     case VR_F: return cm->s.F;
-    case VR_F_avg: return fm->F_avg;
-    case VR_F_avg_next: return fm->started ? fm->F_avg_next : cm->s.F;
+    case VR_F_avg: return fm->F_avg + (fm->coupling == COUPLING_GAUSS_SEIDEL ? fm->correction : 0.0);
+    case VR_F_avg_next: return fm->started ? fm->F_avg_next + (fm->coupling == COUPLING_JACOBI ? fm->correction : 0.0)
+                                           : cm->s.F;
     case VR_F_peak: return cm->s.F_peak;
     case VR_x: return contact_total_indentation(cm);
     case VR_x1: return contact_elastic_indentation(cm);
@@ -399,6 +402,8 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
      * vanishing step (0 at the start, where the striker has not touched). */
     fm->F_avg_next = fm->model.s.F;
     fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
+    memset(&fm->energy, 0, sizeof fm->energy);
+    fm->correction = 0.0;
     fm->predicted = fm->computed = 0;
     fm->next.valid = 0;
     fm->held = 0;
@@ -549,6 +554,49 @@ static int predicted_step(const fmu_model *fm, double H, unsigned stop_at, doubl
            && !(stop_at && p->event);
 }
 
+/* Whether the model's striker is a proxy the master's bodies follow. */
+static int proxy_striker(const fmu_model *fm)
+{
+    return fm->params.scene == CONTACT_SCENE_DRIVEN && fm->in.m > 0.0;
+}
+
+/* The bodies' approach acceleration apart from the contact. */
+static double bodies_accel(const fmu_model *fm)
+{
+    return fm->params.g + other_accel(&fm->in);
+}
+
+/* A whole communication step of length H taken from the proxy state
+ * *start with the impulse J, the impulse owed before it `owed`: its
+ * interval in the energy account, and the correction to the force output
+ * for the bodies' interval that has not yet begun to take it (this one
+ * under Gauss-Seidel, the next under Jacobi). */
+static void account_step(fmu_model *fm, double H, const contact_state *start, double J, double owed)
+{
+    coupling_energy *e = &fm->energy, next;
+    const contact_model *cm = &fm->model;
+    const prediction *p = &fm->next;
+    const double m = proxy_mass(&fm->in);
+    if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
+        coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->F_avg);
+        coupling_energy_proxy(e, cm, start, &cm->s, J, 0.0, 0.0);
+        fm->correction = coupling_energy_correction(e, m);
+        e->F += fm->correction;
+        return;
+    }
+    coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->announced + fm->correction);
+    coupling_energy_proxy(e, cm, start, &cm->s, J, owed / m, fm->owed / m);
+    /* the next interval: the bodies' start predicted from this one's, the
+     * proxy's motion from its own end (owing nothing then), moved to it */
+    next = coupling_energy_predicted(e, m);
+    coupling_energy_open(&next, fm->step_H, next.u, next.a, fm->F_avg_next);
+    coupling_energy_proxy(&next, cm, &cm->s, p->valid ? &p->model.s : &cm->s, fm->F_avg_next * fm->step_H - fm->owed,
+                          fm->owed / m, 0.0);
+    next.u1 += next.u - next.u0;
+    next.u0 = next.u;
+    fm->correction = coupling_energy_correction(&next, m);
+}
+
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
 {
     contact_model *cm = &fm->model;
@@ -562,6 +610,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
                  announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
+    const coupling_energy energy = fm->energy;
+    const double correction = fm->correction;
     int from_prediction, other_coupling;
     *event = 0;
     /* A refused step changes nothing, so the checks come first: a uniform
@@ -583,6 +633,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->step_start = t;
         fm->step_H = H;
     }
+    if (!resume && proxy_striker(fm)) /* the inputs end the bodies' last interval */
+        coupling_energy_close(&fm->energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
     t_start = cm->s.t;
     v_end = cm->s.v;
     contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
@@ -597,6 +649,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         impulse = contact_advance_until(cm, H, stop_at);
     }
     if (isnan(impulse)) {
+        fm->energy = energy;
         fm->announced = announced;
         fm->step_start = step_start;
         fm->step_H = step_H;
@@ -637,6 +690,12 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
      * this step, held. */
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
+    if (proxy_striker(fm) && !resume && !*event)
+        account_step(fm, H, &before, impulse, owed);
+    else { /* a step cut at an event: left out of the account */
+        fm->energy.open = 0;
+        fm->correction = 0.0;
+    }
     overflow = nonfinite_output(fm);
     if (overflow) {
         double value = real_output(fm, overflow->vr);
@@ -645,6 +704,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->F_avg = F_avg;
         fm->step_span = step_span;
         fm->F_avg_next = F_avg_next;
+        fm->energy = energy;
+        fm->correction = correction;
         fm->owed = owed;
         fm->announced = announced;
         fm->step_start = step_start;
@@ -698,7 +759,9 @@ static const state_field state_fields[] = {
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
     F(in.a2), F(v_slope), F(F_avg), F(step_span),
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps),
+    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.rounding), F(energy.H),
+    F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1),
+    F(energy.F_end), F(energy.scale), I(energy.open), F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

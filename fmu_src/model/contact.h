@@ -193,6 +193,49 @@ typedef struct {
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
 
+/* The energy account of a proxy striker's coupling (passivity.c, docs/model.md
+ * §17), over the intervals of the communication steps: from the bodies'
+ * approach speed u and acceleration a apart from the contact (g + a - a2)
+ * at each interval's ends, the force F they take over it, and the proxy's
+ * motion over it, the energy the coupling creates and does not return when
+ * the contact's force does. */
+typedef struct {
+    double created;      /* over the closed intervals [J]; > 0: energy created */
+    double rounding;     /* the sizes of the terms the account added [J] (ACCOUNT_ROUNDING of it is rounding) */
+    double H, u, a;      /* the open interval: its length, the bodies' u and a at its start */
+    double a_rate;       /* a's rate over the last closed interval (0 before one) */
+    double a_unseen;     /* the bodies' mean acceleration over it that neither a nor F explains: a force
+                            the inputs do not show (0 where a holds all the other forces) */
+    double F;            /* the force the bodies take over the open interval [N] */
+    double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
+    double F_end;        /* the proxy's contact force at its end [N] */
+    double scale;        /* the size of its terms [J] */
+    int open;            /* an interval whose end the next inputs tell */
+} coupling_energy;
+
+/* Opens an interval of length H from the bodies' u and a under the force
+ * F; the proxy's motion over it, from *from to *to of the model *cm with
+ * the impulse J, w0 and w1 the velocities the impulse owed to the bodies
+ * at its start and end gives them (0 but under Jacobi); closes it from the
+ * bodies' u and a at its end, adding what it created and taking a's rate
+ * and the unseen acceleration (nothing when none is open). */
+void coupling_energy_open(coupling_energy *e, double H, double u, double a, double F);
+void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const contact_state *from,
+                           const contact_state *to, double J, double w0, double w1);
+void coupling_energy_close(coupling_energy *e, double m, double u, double a);
+
+/* The bodies' approach speed at the end of the open interval under the
+ * force F: from its start, a, a's rate and the unseen acceleration; the
+ * account with the open interval closed there (u and a: that end's). */
+double coupling_energy_end_velocity(const coupling_energy *e, double m, double F);
+coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
+
+/* The change to the force F held over the open interval that brings the
+ * energy created, with the interval's own, to 0 where it is > 0 beyond
+ * the account's rounding: only ever taking more energy from the bodies; 0
+ * otherwise; never larger than F itself (a force >= 0 stays so). */
+double coupling_energy_correction(const coupling_energy *e, double m);
+
 /* The paper's h20 test (docs/model.md §1): the parameters, and the
  * striker's impact velocity v [m/s] and mass m [kg]. */
 void contact_default_params(contact_params *p);
