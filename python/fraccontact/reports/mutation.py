@@ -71,8 +71,8 @@ def mutant(name, category, change, claim, *edits):
 G1, MODEL, STATE, INSTANCE = \
     "fmu_src/model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
 # The model's files (fmu_src/model/): one responsibility each.
-PARAMETERS, LIFE, STAGE, SDIRK2, EVENTS, EVOLVE = ("fmu_src/model/" + f for f in (
-    "parameters.c", "model.c", "stage.h", "sdirk2.c", "events.c", "evolve.c"))
+PARAMETERS, LIFE, STAGE, SDIRK2, EVENTS, EVOLVE, PASSIVITY = ("fmu_src/model/" + f for f in (
+    "parameters.c", "model.c", "stage.h", "sdirk2.c", "events.c", "evolve.c", "passivity.c"))
 CONTACT_H = "fmu_src/model/contact.h"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
@@ -167,6 +167,17 @@ MUTANTS = [
            STRUCTURAL + "; test_readme::test_the_readme_master_loop_is_the_drop_test with g, bit-exact "
            "drop vs driven (test_fmu_coupling)",
            (LIFE, "cm->accel = m > 0.0 ? cm->p.g + accel : accel;", "cm->accel = m > 0.0 ? accel : accel;")),
+    mutant("energy-displacement", "energy account", "the bodies' displacement by the trapezoid, not Hermite's "
+           "quadrature (the change of a over the interval ignored)",
+           "the held force's share of the energy a spring makes, k_s v H^3 / (12 m) a step; "
+           "test_two_bodies::test_the_energy_correction_takes_back_no_more_than_the_coupling_creates: "
+           "energy_error >= -C, the closed form of what the coupling creates",
+           (PASSIVITY, "return 0.5 * H * (u_start + u_end) + H * H * (a_start - a_end) / 12.0;",
+            "return 0.5 * H * (u_start + u_end) + 0.0 * (a_start - a_end);")),
+    mutant("energy-correction-off", "energy account", "the correction computed but never applied",
+           "the energy a coupled spring creates, second order in H; test_jacobi / test_two_bodies / test_scenes: "
+           "energy_error <= 1e-12 of the impact's",
+           (PASSIVITY, "return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;", "return 0.0 * d;")),
     mutant("proxy-mass", "proxy striker", "the proxy striker's 1/m one ulp high",
            "1 ulp; test_fmu_coupling::test_mass_aware_coupling_with_an_exact_master_is_the_drop_test: bit for bit",
            (LIFE, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
