@@ -7,7 +7,8 @@ the same cases, at the error-controlled setting of a calibration campaign
     process, on the same cases in the same tasks, in the same run; in wall
     time and in CPU time (the command's, its children's included);
   - two workers against one; the local cluster's threads (the default)
-    against its processes (--processes);
+    against its processes (--processes); and the C core itself on two
+    threads against one, this machine's ceiling for two workers;
   - the serial fraction: the one-worker time outside its tasks over the
     one-worker time, and where it goes;
   - the client's peak RSS (its process, the worker threads in it) for 10^5
@@ -30,6 +31,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -105,6 +107,29 @@ def core(impacts, folder):
     return spent
 
 
+def core_threads(impacts, folder):
+    """The C core's own scaling on this machine, the ceiling of the
+    workers': the sweep's tasks with their inputs drawn beforehand, run by
+    the library in one thread, then in two at once (each every other task;
+    the library calls release the GIL); wall seconds of each."""
+    args = options.arguments(["--monte-carlo", str(impacts), *SETTING, "--out", str(folder / "core")], "")[1]
+    plan, size, _ = options.prepared(args)
+    work = [(plan.cases.inputs(start, stop)[1], stop - start) for _, start, stop in cases.ranges(plan.cases.n, size)]
+
+    def run(part):
+        for given, n in part:
+            tasks.library_results(plan.fixed, given, n)
+
+    began = time.perf_counter()
+    run(work)
+    one = time.perf_counter() - began
+    with ThreadPoolExecutor(2) as pool:
+        began = time.perf_counter()
+        list(pool.map(run, (work[0::2], work[1::2])))
+        two = time.perf_counter() - began
+    return dict(one=one, two=two)
+
+
 def partitions(out):
     """The partitions' bytes and sweep.json's statistics."""
     return [(f.name, f.read_bytes()) for f in sorted((out / "sweep.parquet").iterdir())], \
@@ -150,11 +175,12 @@ class Remote:
 
 
 def measure(folder):
-    runs = dict(core=[], one=[], two=[], one_processes=[], two_processes=[])
+    runs = dict(core=[], core_threads=[], one=[], two=[], one_processes=[], two_processes=[])
     for r in range(REPEATS):
         say(f"  round {r + 1} of {REPEATS}: the C core, then 1 and 2 workers, threads and processes, {IMPACTS:,} "
             "impacts ...")
         runs["core"].append(core(IMPACTS, folder))
+        runs["core_threads"].append(core_threads(IMPACTS, folder))
         runs["one"].append(sweep(folder, f"one{r}", IMPACTS, "--workers", "1"))
         runs["two"].append(sweep(folder, f"two{r}", IMPACTS, "--workers", "2"))
         runs["one_processes"].append(sweep(folder, f"one_processes{r}", IMPACTS, "--workers", "1", "--processes"))
@@ -203,6 +229,8 @@ def figures(runs):
     f = {}
     f["core"] = IMPACTS / median(c["wall"] for c in runs["core"])
     f["core_cpu"] = IMPACTS / median(c["cpu"] for c in runs["core"])
+    f["core_one"] = IMPACTS / median(c["one"] for c in runs["core_threads"])
+    f["core_two"] = IMPACTS / median(c["two"] for c in runs["core_threads"])
     for name in ("one", "two", "one_processes", "two_processes"):
         f[name] = {key: median(serial(r)[key] for r in runs[name]) for key in serial(runs[name][0])}
     for name in ("large_one", "large_two"):
@@ -265,6 +293,8 @@ def lines(runs, f, load, head, minutes):
         f"worker: {IMPACTS / one['tasks']:,.0f} | {one['tasks'] / f['two']['tasks']:.2f}x | | |",
         f"| two workers, {LARGE:,} impacts, end to end: impacts/s | {f['large_two_rate']:,.0f} | one worker: "
         f"{f['large_rate']:,.0f} | {f['large_speedup']:.2f}x | >= 1.9x | {met(f['large_speedup'] >= 1.9)} |",
+        f"| the C core itself on two threads at once (the tasks' inputs drawn beforehand, no Dask): impacts/s | "
+        f"{f['core_two']:,.0f} | one thread: {f['core_one']:,.0f} | {f['core_two'] / f['core_one']:.2f}x | | |",
         f"| serial fraction, one worker, {IMPACTS:,} impacts: time outside the tasks / end to end | "
         f"{one['total'] - one['inside']:.2f} s | {one['total']:.2f} s | {100 * f['fraction']:.1f} % | <= 2 % | "
         f"{met(f['fraction'] <= 0.02)} |",
