@@ -224,10 +224,9 @@ void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const co
                            const contact_state *to, double J, double w0, double w1);
 void coupling_energy_close(coupling_energy *e, double m, double u, double a);
 
-/* The bodies' approach speed at the end of the open interval under the
- * force F: from its start, a, a's rate and the unseen acceleration; the
- * account with the open interval closed there (u and a: that end's). */
-double coupling_energy_end_velocity(const coupling_energy *e, double m, double F);
+/* The account with the open interval closed where the bodies are predicted
+ * to end it (from its start, a, a's rate and the acceleration the inputs
+ * did not show), u and a that end's. */
 coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 
 /* The change to the force F held over the open interval that brings the

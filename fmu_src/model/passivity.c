@@ -64,7 +64,16 @@ void coupling_energy_close(coupling_energy *e, double m, double u, double a)
     e->open = 0;
 }
 
-double coupling_energy_end_velocity(const coupling_energy *e, double m, double F)
+/* The bodies' acceleration apart from the contact at the open interval's
+ * end, a's rate over the last closed interval carried on. */
+static double end_accel(const coupling_energy *e)
+{
+    return e->a + e->H * e->a_rate;
+}
+
+/* The bodies' approach speed at the end of the open interval under the
+ * force F: from its start, a, a's rate and the unseen acceleration. */
+static double end_velocity(const coupling_energy *e, double m, double F)
 {
     return e->u + e->H * (e->a + e->a_unseen + 0.5 * e->H * e->a_rate - F / m);
 }
@@ -72,7 +81,7 @@ double coupling_energy_end_velocity(const coupling_energy *e, double m, double F
 coupling_energy coupling_energy_predicted(const coupling_energy *e, double m)
 {
     coupling_energy next = *e;
-    const double u_end = coupling_energy_end_velocity(e, m, e->F), a_end = e->a + e->H * e->a_rate;
+    const double u_end = end_velocity(e, m, e->F), a_end = end_accel(e);
     coupling_energy_close(&next, m, u_end, a_end); /* the rates it takes are e's again */
     next.u = u_end;
     next.a = a_end;
@@ -102,10 +111,10 @@ static double smallest_change(double E, double g, double c)
  * displacement X - c F shortens by c d (c = H^2/(2m)). */
 double coupling_energy_correction(const coupling_energy *e, double m)
 {
-    const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = e->a + H * e->a_rate;
-    const double X = displacement(H, e->u, coupling_energy_end_velocity(e, m, 0.0), e->a, a_end);
+    const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = end_accel(e);
+    const double X = displacement(H, e->u, end_velocity(e, m, 0.0), e->a, a_end);
     const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * (X - c * F0)));
-    const double created = e->created + secular(e, m, coupling_energy_end_velocity(e, m, F0), a_end);
+    const double created = e->created + secular(e, m, end_velocity(e, m, F0), a_end);
     const double d = smallest_change(created - noise, X + m * e->a * c - 2.0 * c * F0, c);
     return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
 }

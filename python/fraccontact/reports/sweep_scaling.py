@@ -84,11 +84,17 @@ def sweep(folder, name, impacts, *extra):
     return dict(json.loads(marks.read_text()), summary=json.loads((out / "sweep.json").read_text()), out=out)
 
 
+def campaign(impacts, folder):
+    """The sweep's plan of the campaign and its task size, as the command makes them."""
+    args = options.arguments(["--monte-carlo", str(impacts), *SETTING, "--out", str(folder / "core")], "")[1]
+    plan, size, _ = options.prepared(args)
+    return plan, size
+
+
 def core(impacts, folder):
     """The C core alone on the sweep's cases and tasks: wall and CPU
     seconds inside fc_run_batch (this thread), around each call."""
-    args = options.arguments(["--monte-carlo", str(impacts), *SETTING, "--out", str(folder / "core")], "")[1]
-    plan, size, _ = options.prepared(args)
+    plan, size = campaign(impacts, folder)
     real = _lib.LIB.fc_run_batch
     spent = dict(wall=0.0, cpu=0.0)
 
@@ -112,8 +118,7 @@ def core_threads(impacts, folder):
     workers': the sweep's tasks with their inputs drawn beforehand, run by
     the library in one thread, then in two at once (each every other task;
     the library calls release the GIL); wall seconds of each."""
-    args = options.arguments(["--monte-carlo", str(impacts), *SETTING, "--out", str(folder / "core")], "")[1]
-    plan, size, _ = options.prepared(args)
+    plan, size = campaign(impacts, folder)
     work = [(plan.cases.inputs(start, stop)[1], stop - start) for _, start, stop in cases.ranges(plan.cases.n, size)]
 
     def run(part):
