@@ -189,14 +189,25 @@ def errors(r, ref):
 
 
 @pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
-def test_a_constant_force_fed_as_a_is_exact_as_g_is(coupling):
+def test_a_constant_force_fed_as_a_is_g(coupling):
     """Gravity in the striker FMU, fed to the contact as a (not as its g):
-    the proxy moves as the striker does, and the co-simulation is the drop
-    test under gravity to rounding."""
+    the proxy moves as the striker does, and the co-simulation is the one
+    with the contact's g to rounding. Neither creates energy beyond the
+    model's own (the monolithic drop test's balance): the striker taking
+    F_avg held over each step ends the contact higher than the proxy did,
+    and the account takes that potential energy back after the contact
+    (docs/model.md §17), so v_end moves off the drop test's by the
+    correction (measured 7.8e-7 relative under Gauss-Seidel at this H,
+    where 5.0e-7 E0 was created before)."""
     ref = monolithic(CONTACT, g=9.81)
-    r = cosimulate(CONTACT, STRIKER, 1e-4, *coupling, g=9.81, feed_a=True)
-    assert r["F_peak"] == pytest.approx(ref["F_peak"], rel=ROUNDING, abs=0)
-    assert r["v_end"] == pytest.approx(ref["v_end"], rel=ROUNDING, abs=0)
+    fed = cosimulate(CONTACT, STRIKER, 1e-4, *coupling, g=9.81, feed_a=True)
+    known = cosimulate(CONTACT, STRIKER, 1e-4, *coupling, g=9.81, g_contact=9.81)
+    assert fed["F_peak"] == pytest.approx(known["F_peak"], rel=ROUNDING, abs=0)
+    assert fed["v_end"] == pytest.approx(known["v_end"], rel=ROUNDING, abs=0)
+    assert fed["energy_error"] <= ref["energy_error"] + ROUNDING
+    # rel 1e-5: the correction's measured 7.8e-7 with room; F_peak is before the correction acts
+    assert fed["v_end"] == pytest.approx(ref["v_end"], rel=1e-5, abs=0)
+    assert fed["F_peak"] == pytest.approx(ref["F_peak"], rel=ROUNDING, abs=0)
 
 
 @pytest.mark.parametrize("coupling", COUPLINGS, ids=["gauss-seidel", "jacobi"])
@@ -222,6 +233,7 @@ def test_a_spring_fed_as_a_is_second_order(spring, coupling):
 
 
 STEPS = (1e-6, 1e-5, 1e-4, 2e-4, 5e-4, 1e-3)  # the report's range, 1 us to 1 ms
+T_REPAID = 6e-3  # three steps of 1 ms after the separation; the spring brings the striker back after 10 ms
 
 
 @pytest.mark.parametrize("H", STEPS)
@@ -231,13 +243,12 @@ def test_a_spring_fed_as_a_creates_no_energy(coupling, H):
     the bodies take so that the energy it creates stays at or below 0: the
     striker's kinetic and spring energy plus the contact's E_diss end below
     the start (main created (k_s / m) (H^2 / 4) E_diss, +2.2e-6 E0 at
-    1e-5 s). Measured -1.4e-8 E0 at 1 us to -1.1e-2 at 0.5 ms. ROUNDING:
-    the energies' rounding over a run, far below the FMU's own dissipation
-    (about -1e-9 E0 at these H), so only a coupling that creates energy
-    fails."""
-    if coupling[1] == "jacobi" and H == 1e-3:
-        pytest.xfail("a Jacobi master at H = 1 ms: the impact (1.3 ms) starts at t = 0 and the force of the "
-                     "second step is announced before the contact has seen a second value of a")
+    1e-5 s). Measured -1.4e-8 E0 at 1 us to -1.1e-1 at 1 ms; a Jacobi
+    master at 1 ms created +0.41 E0 before the account counted the proxy's
+    own work at the contact's end and could pull the separated bodies.
+    ROUNDING: the energies' rounding over a run, far below the FMU's own
+    dissipation (about -1e-9 E0 at these H), so only a coupling that
+    creates energy fails."""
     r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S, feed_a=True)
     assert r["energy_error"] <= ROUNDING
 
@@ -248,11 +259,13 @@ def test_a_spring_the_contact_does_not_see_creates_no_energy(coupling, H):
     """Blind (a not fed), the account still sees the bodies' velocities at
     both ends of each step, and the energy the unseen spring makes the
     coupling create (first order in H on main: +7.8e-4 E0 at 1e-5 s) is
-    taken back (measured -9.9e-9 to -9.8e-3 E0)."""
-    if coupling[1] == "jacobi" and H >= 5e-4:
-        pytest.xfail("a Jacobi master at H >= 0.5 ms: the force of the second step is announced before the "
-                     "contact has seen how the unseen spring slowed the striker in the first")
-    r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S)
+    taken back (measured -9.9e-9 to -9.8e-3 E0). Under Jacobi at 1 ms the
+    force of each step is fixed a step before the inputs that end the step
+    before it: what the unseen spring did in the impact's last step is
+    taken back from the separated bodies over the following steps (+8.3e-2
+    E0 at 3 ms, +2.3e-2 at 4, +3.3e-3 at 5, -3.5e-3 at 6), so the runs go on
+    to T_REPAID."""
+    r = cosimulate(CONTACT, STRIKER, H, *coupling, k_s=K_S, t_end=T_REPAID)
     assert r["energy_error"] <= ROUNDING
 
 

@@ -639,6 +639,8 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     v_end = cm->s.v;
     contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
                   fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
+    if (!resume && proxy_striker(fm))
+        coupling_energy_restart(&fm->energy, fm->coupling == COUPLING_JACOBI ? fm->owed : 0.0, cm->s.v - v_end);
     before = cm->s;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
@@ -761,7 +763,8 @@ static const state_field state_fields[] = {
     I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
     I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.rounding), F(energy.H),
     F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1),
-    F(energy.F_end), F(energy.scale), I(energy.open), F(correction),
+    F(energy.F_end), F(energy.dx), F(energy.scale), F(energy.lag), I(energy.open), I(energy.ends_free),
+    F(correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values

@@ -209,8 +209,12 @@ typedef struct {
     double F;            /* the force the bodies take over the open interval [N] */
     double u0, u1;       /* the proxy's velocity at its start and end, any impulse owed to the bodies included */
     double F_end;        /* the proxy's contact force at its end [N] */
+    double dx;           /* the proxy's own displacement over it [m] */
     double scale;        /* the size of its terms [J] */
+    double lag;          /* over the closed intervals since the contact began: the proxy's own work less
+                            what `created` counted of it, energy the contact holds until it ends [J] */
     int open;            /* an interval whose end the next inputs tell */
+    int ends_free;       /* the proxy is out of contact at its end */
 } coupling_energy;
 
 /* Opens an interval of length H from the bodies' u and a under the force
@@ -224,6 +228,12 @@ void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const co
                            const contact_state *to, double J, double w0, double w1);
 void coupling_energy_close(coupling_energy *e, double m, double u, double a);
 
+/* The proxy restarted from the bodies' velocity, dv from where its last
+ * interval ended, with the impulse `owed` not yet given to them: the
+ * energy that moves between the proxy and the bodies (0 under
+ * Gauss-Seidel, which owes nothing). */
+void coupling_energy_restart(coupling_energy *e, double owed, double dv);
+
 /* The account with the open interval closed where the bodies are predicted
  * to end it (from its start, a, a's rate and the acceleration the inputs
  * did not show), u and a that end's. */
@@ -232,7 +242,8 @@ coupling_energy coupling_energy_predicted(const coupling_energy *e, double m);
 /* The change to the force F held over the open interval that brings the
  * energy created, with the interval's own, to 0 where it is > 0 beyond
  * the account's rounding: only ever taking more energy from the bodies; 0
- * otherwise; never larger than F itself (a force >= 0 stays so). */
+ * otherwise. On bodies that separate it pulls: a force >= 0 could only
+ * give them more. */
 double coupling_energy_correction(const coupling_energy *e, double m);
 
 /* The paper's h20 test (docs/model.md §1): the parameters, and the

@@ -48,7 +48,34 @@ void coupling_energy_proxy(coupling_energy *e, const contact_model *cm, const co
     e->u0 = from->v + w0;
     e->u1 = v1 + w1;
     e->F_end = to->F;
+    e->dx = (to->x1 + to->x2) - (from->x1 + from->x2);
+    e->ends_free = !to->in_contact;
     e->scale = 0.5 * (e->u0 * e->u0 + e->u1 * e->u1) / cm->inv_m;
+}
+
+/* The proxy's own work on the contact over the open interval, by its
+ * equation of motion (m v' = m a - F, a held), less what secular() counts
+ * of it: the held acceleration's work on the proxy's own path instead of
+ * the bodies' (the two paths part while the force changes within a step,
+ * and meet again only where it is smooth); 0 with a constant a and no
+ * force. The owed impulse's share is counted where the proxy restarts. */
+static double lag(const coupling_energy *e, double m, double dx_bodies, double da)
+{
+    return m * e->a * (e->dx - dx_bodies + da * e->H * e->H / 6.0) + e->F_end * da * e->H * e->H / 12.0;
+}
+
+/* Adds the open interval's share of the lag and, where the contact is
+ * over at its end, the whole lag to what was created: the proxy's work
+ * is then all the contact has taken, less what the bodies gave it. */
+static void add_lag(coupling_energy *e, double m, double dx_bodies, double da)
+{
+    const double share = lag(e, m, dx_bodies, da);
+    e->lag += share;
+    e->rounding += fabs(m * e->a * e->dx) + fabs(share);
+    if (e->ends_free) {
+        e->created += e->lag;
+        e->lag = 0.0;
+    }
 }
 
 void coupling_energy_close(coupling_energy *e, double m, double u, double a)
@@ -59,9 +86,18 @@ void coupling_energy_close(coupling_energy *e, double m, double u, double a)
     dx = displacement(e->H, e->u, u, e->a, a);
     e->created += secular(e, m, u, a);
     e->rounding += e->scale + fabs(e->F * dx);
+    add_lag(e, m, dx, a - e->a);
     e->a_rate = (a - e->a) / e->H;
     e->a_unseen = (u - e->u) / e->H + e->F / m - 0.5 * (e->a + a);
     e->open = 0;
+}
+
+void coupling_energy_restart(coupling_energy *e, double owed, double dv)
+{
+    /* the secular terms count the owed impulse as taken at the bodies'
+     * velocity, which the restart moves by dv against the proxy's */
+    e->created -= owed * dv;
+    e->rounding += fabs(owed * dv);
 }
 
 /* The bodies' acceleration apart from the contact at the open interval's
@@ -100,6 +136,16 @@ static double smallest_change(double E, double g, double c)
     return disc < 0.0 ? g / (2.0 * c) : 2.0 * E / (g + copysign(sqrt(disc), g));
 }
 
+/* A change d of the force F0 that never turns it round, but for a pull on
+ * a proxy that ends the interval out of contact: the contact is over, and
+ * a push could only give the separating bodies more energy. */
+static double limited(double d, double F0, int ends_free)
+{
+    if (fabs(d) <= fabs(F0) || (ends_free && d < 0.0))
+        return d;
+    return copysign(fabs(F0), d);
+}
+
 /* The account adds terms of the size of the kinetic energies and works of
  * each interval (`rounding` sums them), each rounded to a few ulps, and
  * the bodies' velocities drift from the proxy's by an ulp a step: an
@@ -108,13 +154,17 @@ static double smallest_change(double E, double g, double c)
 #define ACCOUNT_ROUNDING (16.0 * DBL_EPSILON)
 
 /* The energy is quadratic in the force: with F = F0 + d the bodies'
- * displacement X - c F shortens by c d (c = H^2/(2m)). */
+ * displacement X - c F shortens by c d (c = H^2/(2m)); where the contact
+ * ends within the interval, the lag's share takes back the held
+ * acceleration's work on that displacement. */
 double coupling_energy_correction(const coupling_energy *e, double m)
 {
     const double F0 = e->F, H = e->H, c = 0.5 * H * H / m, a_end = end_accel(e);
     const double X = displacement(H, e->u, end_velocity(e, m, 0.0), e->a, a_end);
     const double noise = ACCOUNT_ROUNDING * (e->rounding + e->scale + fabs(F0 * (X - c * F0)));
-    const double created = e->created + secular(e, m, end_velocity(e, m, F0), a_end);
-    const double d = smallest_change(created - noise, X + m * e->a * c - 2.0 * c * F0, c);
-    return fabs(d) > fabs(F0) ? copysign(fabs(F0), d) : d;
+    const double a_work = e->ends_free ? 0.0 : m * e->a * c;
+    double created = e->created + secular(e, m, end_velocity(e, m, F0), a_end);
+    if (e->ends_free)
+        created += e->lag + lag(e, m, X - c * F0, a_end - e->a);
+    return limited(smallest_change(created - noise, X + a_work - 2.0 * c * F0, c), F0, e->ends_free);
 }
