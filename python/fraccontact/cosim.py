@@ -50,6 +50,7 @@ ORDERS = ("jacobi", "gauss-seidel")
 # What each coupling connects to the striker's force, and the contact's
 # settings for it: its proxy striker's mass and its parameter coupling.
 FORCE = {"zoh": "F", "mass-aware": "F_avg", "predictive": "F_avg_next"}
+T_END = 3e-3  # a run's end: the h20 impact (1.3 ms) and its rebound
 MONOLITHIC_STEP = 1e-5  # the reference's communication step (its internal steps are dt_max's whatever it is)
 # The communication steps a run may take (the command's, and its reference's): fmpy's calls cost some
 # microseconds each, so this bounds a run to minutes.
@@ -147,7 +148,7 @@ def finished(eps_contact):
     return eps_contact > 0
 
 
-def monolithic(contact_fmu, t_end=3e-3, H=MONOLITHIC_STEP, law=2, g=0.0, m=M, v=V0):
+def monolithic(contact_fmu, t_end=T_END, H=MONOLITHIC_STEP, law=2, g=0.0, m=M, v=V0):
     """The reference: the contact FMU's own drop test, same model and dt_max
     (the closed-form Hertz law unless law says otherwise), its striker of
     mass m at v under the acceleration g; v_end is its velocity at t_end,
@@ -188,7 +189,7 @@ def spring_reference(k_s):
     return solve_drop(d["k"], d["c"], M, V0, method="DOP853", rtol=1e-12, k_s=k_s)
 
 
-def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=False, g=0.0, g_contact=0.0,
+def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=T_END, trace=False, g=0.0, g_contact=0.0,
                k_s=0.0, feed_a=False, m=M, v=V0, m2=0.0, v2=0.0):
     """One co-simulation of the h20 drop (or of a striker of mass m at v),
     the striker under gravity g (which the contact's proxy striker knows as
@@ -244,7 +245,7 @@ def cosimulate(contact_fmu, striker_fmu, H, coupling, order, t_end=3e-3, trace=F
     return figures
 
 
-def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=3e-3, g=0.0, g_contact=0.0, k_s=0.0):
+def cosimulate_libcosim(contact_fmu, striker_fmu, H, coupling, t_end=T_END, g=0.0, g_contact=0.0, k_s=0.0):
     """The same scene in libcosim (Open Simulation Platform, via libcosimpy):
     an independent FMI 2.0 importer. Its fixed-step algorithm steps every
     FMU from the last exchanged values: the Jacobi order."""
