@@ -321,6 +321,20 @@ def test_bad_second_body_inputs_are_refused_and_the_instance_stays_usable(slave,
     assert s.get("F") > 0
 
 
+def test_a_relative_motion_beyond_double_is_named_as_such(slave):
+    """Each body's own motion passes the striker's rules, their relative
+    motion does not (the reduced mass's kinetic energy overflows): the
+    message names the approach speed and the reduced mass, not v and m."""
+    s = slave(scene=2, law=2, m=1.0, m2=1.0, v=1.5e154)
+    with pytest.raises(FMICallException):
+        s.set(v2=-1.5e154)
+    assert ("the relative motion of the two bodies (v - v2 = 3e+154 m/s, reduced mass m m2/(m + m2) = 0.5 kg) "
+            "breaks the striker's rule: v = 3e+154 is invalid: the striker's kinetic energy") in s.last_error()
+    assert s.get("v2") == 0.0
+    s.set(v2=-1.0)  # the instance stays usable
+    assert s.get("v2") == -1.0
+
+
 def test_an_approach_speed_beyond_double_is_refused(slave):
     s = slave(scene=2, law=2, damper=2, m=0.0, v=1e308)  # the springpot: no dashpot power c v^2 to overflow
     with pytest.raises(FMICallException):

@@ -140,6 +140,22 @@ static double other_accel(const bodies *b)
     return b->a - b->a2;
 }
 
+/* The striker's rules applied to the relative motion, whose approach
+ * speed and reduced mass the message names as such (the rule's own words
+ * say v and m). */
+static int check_relative_motion(const contact_params *p, int scene, const bodies *b, char *why, size_t len)
+{
+    const double u = approach(b), m_r = proxy_mass(b);
+    int n;
+    if (contact_check_striker(p, scene, u, m_r, why, len) == 0)
+        return 0;
+    n = snprintf(why, len, "the relative motion of the two bodies (v - v2 = %g m/s, reduced mass m m2/(m + m2) = %g "
+                 "kg) breaks the striker's rule: ", u, m_r);
+    if (n > 0 && (size_t)n < len)
+        contact_check_striker(p, scene, u, m_r, why + n, len - (size_t)n);
+    return -1;
+}
+
 /* 0 when the inputs are usable in `scene` with the parameters *p (which
  * passed their check), else -1 and why: the striker's own rules, and the
  * same for the model's striker, the relative motion (the approach speed
@@ -167,7 +183,7 @@ static int check_bodies(const contact_params *p, int scene, const bodies *b, cha
         return contact_reject(why, len, "a", b->a,
                               "the approach's acceleration g + a - a2 must be finite, and so must the power "
                               "(m_r (g + a - a2))^2 / c it can dissipate (m_r the reduced mass m m2/(m + m2))");
-    return b->v2 == 0.0 && b->m2 == 0.0 ? 0 : contact_check_striker(p, scene, approach(b), mass, why, len);
+    return b->v2 == 0.0 && b->m2 == 0.0 ? 0 : check_relative_motion(p, scene, b, why, len);
 }
 
 /* Applies a parameter change only if the parameters stay valid. */
