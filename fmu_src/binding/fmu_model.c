@@ -708,9 +708,9 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
      * this step, held. */
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
-    if (proxy_striker(fm) && !resume && !*event)
-        account_step(fm, H, &before, impulse, owed);
-    else { /* a step cut at an event: left out of the account */
+    if (proxy_striker(fm) && !resume) /* an early return's part is the master's whole step */
+        account_step(fm, part, &before, impulse, owed);
+    else { /* the rest of a step cut at an event inside the FMU: the step left out of the account */
         fm->energy.open = 0;
         fm->correction = 0.0;
     }
