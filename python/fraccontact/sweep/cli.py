@@ -18,6 +18,13 @@ from . import cases, options, outputs, stats, tasks
 # Results folded together on a worker at a time: a tree of summaries
 # rather than a list on the client.
 FAN_IN = 8
+# The local cluster's settings. Dask's profiler samples every thread's stack
+# every few milliseconds, for a profile nobody reads here; its event loop's
+# tick, its system monitor and its memory monitor wake many times a second:
+# CPU beside the tasks, taken from them when they occupy every core, and
+# growing with the campaign. A few wakes a second suffice here.
+QUIET = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+         "distributed.admin.system-monitor.interval": "5s", "distributed.worker.memory.monitor-interval": "1s"}
 # Tasks given to the cluster at once, for each of its threads: enough to
 # keep every thread busy while the client hears of a finished one.
 WINDOW = 2
@@ -37,10 +44,7 @@ def connect(args):
         # No dashboard; the scheduler's HTTP server (its metrics) on a free
         # port of the loopback, not on 8787, which another cluster may hold.
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
-        # Dask's profiler samples every thread's stack every few milliseconds:
-        # CPU beside the tasks, growing with the campaign, for a profile
-        # nobody reads here.
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
+        with dask.config.set(QUIET):
             if not args.processes:
                 cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
                 return Client(cluster), cluster
