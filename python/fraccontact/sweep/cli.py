@@ -3,6 +3,7 @@ window at a time and their summaries folded on the workers (the
 statistics' among them), then the CSV when asked, the plot and
 sweep.json."""
 
+import ctypes
 import importlib
 import json
 import math
@@ -25,6 +26,12 @@ FAN_IN = 8
 # growing with the campaign. A few wakes a second suffice here.
 QUIET = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
          "distributed.admin.system-monitor.interval": "5s", "distributed.worker.memory.monitor-interval": "1s"}
+# glibc's malloc settings in the local workers: arrays below MALLOC_MMAP_THRESHOLD
+# from its heap, and up to MALLOC_TRIM_THRESHOLD of freed memory kept there.
+# Otherwise a task's arrays, freed, go back to the system and the next
+# task's come in fresh pages, each a fault: system time in every task.
+# (environment variable, mallopt's parameter number, value)
+MALLOC = (("MALLOC_MMAP_THRESHOLD_", -3, 32 << 20), ("MALLOC_TRIM_THRESHOLD_", -1, 64 << 20))
 # Tasks given to the cluster at once, for each of its threads: enough to
 # keep every thread busy while the client hears of a finished one.
 WINDOW = 2
@@ -46,13 +53,11 @@ def connect(args):
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
         with dask.config.set(QUIET):
             if not args.processes:
+                keep_freed_memory()
                 cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
                 return Client(cluster), cluster
-            # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which
-            # also keeps glibc from raising its mmap threshold: every array of
-            # a task would then come in fresh pages. The local workers keep
-            # glibc's own.
-            with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            # In place of the MALLOC_TRIM_THRESHOLD_ Dask's nanny would set.
+            with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value for name, _, value in MALLOC}):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
             return Client(cluster), cluster
     try:
@@ -62,6 +67,13 @@ def connect(args):
     except OSError:
         raise ValueError(f"--scheduler {args.scheduler}: no Dask scheduler answered there within "
                          f"{options.CONNECT_TIMEOUT:g} s") from None
+
+
+def keep_freed_memory():
+    """MALLOC in this process, where the C library has mallopt."""
+    mallopt = getattr(ctypes.CDLL(None), "mallopt", None)
+    for _, parameter, value in MALLOC if mallopt else ():
+        mallopt(parameter, value)
 
 
 def fold(client, calls, combine, window, done=None):
