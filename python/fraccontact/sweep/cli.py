@@ -152,8 +152,36 @@ def simulate(args, client, plan, size, folder):
              for i, start, stop in cases.ranges(n, size))
     with tqdm(total=n, unit=" impacts", unit_scale=True, file=sys.stderr, disable=None, smoothing=0.1) as bar:
         start = time.perf_counter()
-        summary = fold(client, calls, tasks.merged, window(client), bar.update).result()
+        plot_import = PlotImport(args, len(range(0, n, size)))
+
+        def done(weight):
+            bar.update(weight)
+            plot_import.task_ended()
+        summary = fold(client, calls, tasks.merged, window(client), done).result()
         return summary, time.perf_counter() - start
+
+
+class PlotImport:
+    """Imports the plot's library in the background (outputs.preload), once,
+    as soon as a CPU of this machine has no task: at once where the workers
+    leave one free (a remote cluster, fewer local workers than CPUs), else
+    when fewer tasks are left than CPUs. The import keeps a CPU and Python's
+    GIL busy: beside tasks on every CPU, it would slow them."""
+
+    def __init__(self, args, count):
+        self.cpus = options.cpus()
+        self.left = 0 if args.scheduler or (args.workers or self.cpus) < self.cpus else count
+        self.started = False
+        self.start_if_free()
+
+    def task_ended(self):
+        self.left -= 1
+        self.start_if_free()
+
+    def start_if_free(self):
+        if not self.started and self.left < self.cpus:
+            self.started = True
+            outputs.preload()
 
 
 def run(args, client, cluster, plan, size, prog):
@@ -175,7 +203,6 @@ def run(args, client, cluster, plan, size, prog):
                   "install '.[sweep]')", file=sys.stderr)
             staging.discard()
             return 2
-        outputs.preload()
         summary, wall = simulate(args, client, plan, size, staging.folder)
         count = len(range(0, plan.cases.n, size))
         began = time.perf_counter()
