@@ -15,6 +15,7 @@ import signal
 import subprocess
 import sys
 import time
+import types
 from fractions import Fraction
 
 import numpy as np
@@ -23,7 +24,7 @@ import pytest
 
 import fraccontact
 from fraccontact import sweep
-from fraccontact.sweep import cases, options, outputs, stats, tasks
+from fraccontact.sweep import cases, cli, options, outputs, stats, tasks
 
 pytestmark = pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
                                 reason="Dask workers under a preloaded sanitizer runtime")
@@ -199,6 +200,26 @@ def test_the_plots_histograms_count_every_value(tmp_path):
     assert np.abs(np.cumsum(counts) - np.cumsum(exact)).max() <= 0.01 * len(x)
 
 
+def test_a_tasks_summaries_use_one_scratch_array():
+    """reduced() summarises twelve columns of n doubles with temporaries
+    of about one column (one scratch array): beside the summaries it
+    returns (their bins' counts), its peak of memory traced stays below
+    one and a half columns, where a temporary for each step (deviations,
+    keys, shifted keys, bins) would hold three or more at once."""
+    import tracemalloc
+    rng = np.random.default_rng(5)
+    n = 200_000
+    columns = {f"x{i}": rng.lognormal(0, 0.1, n) for i in range(12)}
+    tracemalloc.start()
+    try:
+        summaries = stats.reduced(columns, [])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    kept = sum(s.counts.nbytes for s in summaries.values())
+    assert peak - kept < 1.5 * 8 * n, (peak, kept)
+
+
 # ---------------------------------------------------------------- outputs, in process
 
 
@@ -289,6 +310,22 @@ def test_library_calls_in_chunks_are_one_batch(monkeypatch):
     results, errors, _ = tasks.library_results(fixed, dict(c=c, k=k), 57)
     assert list(errors) == [40] and "c" in errors[40] and np.isnan(results["k"][40])
     assert np.delete(results["F_peak"], 40).tobytes() == np.delete(truth.F_peak, 40).tobytes()
+
+
+@pytest.mark.parametrize("scheduler, workers, preloaded_after", [(None, 2, 4), (None, 1, 0), ("tcp://host:8786", 2, 0)])
+def test_the_plots_library_is_imported_once_a_cpu_is_free(monkeypatch, scheduler, workers, preloaded_after):
+    """On 2 CPUs, 5 tasks: with a local worker thread on every CPU, the
+    plot's library is imported (in the background, once) when the fourth
+    task has ended and one is left; with a CPU to spare, or a remote
+    cluster, at once."""
+    monkeypatch.setattr(options, "cpus", lambda: 2)
+    ended, started = [0], []
+    monkeypatch.setattr(outputs, "preload", lambda: started.append(ended[0]))
+    plot_import = cli.PlotImport(types.SimpleNamespace(scheduler=scheduler, workers=workers), 5)
+    for _ in range(5):
+        ended[0] += 1
+        plot_import.task_ended()
+    assert started == [preloaded_after]
 
 
 def test_a_monte_carlo_campaign_reads_no_partition_back(tmp_path, monkeypatch):

@@ -3,6 +3,7 @@ window at a time and their summaries folded on the workers (the
 statistics' among them), then the CSV when asked, the plot and
 sweep.json."""
 
+import ctypes
 import importlib
 import json
 import math
@@ -18,6 +19,19 @@ from . import cases, options, outputs, stats, tasks
 # Results folded together on a worker at a time: a tree of summaries
 # rather than a list on the client.
 FAN_IN = 8
+# The local cluster's settings. Dask's profiler samples every thread's stack
+# every few milliseconds, for a profile nobody reads here; its event loop's
+# tick, its system monitor and its memory monitor wake many times a second:
+# CPU beside the tasks, taken from them when they occupy every core, and
+# growing with the campaign. A few wakes a second suffice here.
+QUIET = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+         "distributed.admin.system-monitor.interval": "5s", "distributed.worker.memory.monitor-interval": "1s"}
+# glibc's malloc settings in the local workers: arrays below MALLOC_MMAP_THRESHOLD
+# from its heap, and up to MALLOC_TRIM_THRESHOLD of freed memory kept there.
+# Otherwise a task's arrays, freed, go back to the system and the next
+# task's come in fresh pages, each a fault: system time in every task.
+# (environment variable, mallopt's parameter number, value)
+MALLOC = (("MALLOC_MMAP_THRESHOLD_", -3, 32 << 20), ("MALLOC_TRIM_THRESHOLD_", -1, 64 << 20))
 # Tasks given to the cluster at once, for each of its threads: enough to
 # keep every thread busy while the client hears of a finished one.
 WINDOW = 2
@@ -37,18 +51,13 @@ def connect(args):
         # No dashboard; the scheduler's HTTP server (its metrics) on a free
         # port of the loopback, not on 8787, which another cluster may hold.
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
-        # Dask's profiler samples every thread's stack every few milliseconds:
-        # CPU beside the tasks, growing with the campaign, for a profile
-        # nobody reads here.
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
+        with dask.config.set(QUIET):
             if not args.processes:
+                keep_freed_memory()
                 cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
                 return Client(cluster), cluster
-            # Dask's nanny sets MALLOC_TRIM_THRESHOLD_ in its workers, which
-            # also keeps glibc from raising its mmap threshold: every array of
-            # a task would then come in fresh pages. The local workers keep
-            # glibc's own.
-            with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            # In place of the MALLOC_TRIM_THRESHOLD_ Dask's nanny would set.
+            with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value for name, _, value in MALLOC}):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
             return Client(cluster), cluster
     try:
@@ -58,6 +67,13 @@ def connect(args):
     except OSError:
         raise ValueError(f"--scheduler {args.scheduler}: no Dask scheduler answered there within "
                          f"{options.CONNECT_TIMEOUT:g} s") from None
+
+
+def keep_freed_memory():
+    """MALLOC in this process, where the C library has mallopt."""
+    mallopt = getattr(ctypes.CDLL(None), "mallopt", None)
+    for _, parameter, value in MALLOC if mallopt else ():
+        mallopt(parameter, value)
 
 
 def fold(client, calls, combine, window, done=None):
@@ -136,8 +152,36 @@ def simulate(args, client, plan, size, folder):
              for i, start, stop in cases.ranges(n, size))
     with tqdm(total=n, unit=" impacts", unit_scale=True, file=sys.stderr, disable=None, smoothing=0.1) as bar:
         start = time.perf_counter()
-        summary = fold(client, calls, tasks.merged, window(client), bar.update).result()
+        plot_import = PlotImport(args, len(range(0, n, size)))
+
+        def done(weight):
+            bar.update(weight)
+            plot_import.task_ended()
+        summary = fold(client, calls, tasks.merged, window(client), done).result()
         return summary, time.perf_counter() - start
+
+
+class PlotImport:
+    """Imports the plot's library in the background (outputs.preload), once,
+    as soon as a CPU of this machine has no task: at once where the workers
+    leave one free (a remote cluster, fewer local workers than CPUs), else
+    when fewer tasks are left than CPUs. The import keeps a CPU and Python's
+    GIL busy: beside tasks on every CPU, it would slow them."""
+
+    def __init__(self, args, count):
+        self.cpus = options.cpus()
+        self.left = 0 if args.scheduler or (args.workers or self.cpus) < self.cpus else count
+        self.started = False
+        self.start_if_free()
+
+    def task_ended(self):
+        self.left -= 1
+        self.start_if_free()
+
+    def start_if_free(self):
+        if not self.started and self.left < self.cpus:
+            self.started = True
+            outputs.preload()
 
 
 def run(args, client, cluster, plan, size, prog):
@@ -159,7 +203,6 @@ def run(args, client, cluster, plan, size, prog):
                   "install '.[sweep]')", file=sys.stderr)
             staging.discard()
             return 2
-        outputs.preload()
         summary, wall = simulate(args, client, plan, size, staging.folder)
         count = len(range(0, plan.cases.n, size))
         began = time.perf_counter()

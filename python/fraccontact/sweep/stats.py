@@ -35,13 +35,16 @@ BITS = 15
 SIGN = np.uint64(1 << 63)
 
 
-def key(x):
+def key(x, out=None):
     """Each double's key: unsigned integers in the doubles' order (the
-    sign bit set for the positive, every bit flipped for the negative)."""
+    sign bit set for the positive, every bit flipped for the negative);
+    written into out when given."""
     bits = np.ascontiguousarray(x, dtype=np.float64).view(np.uint64)
-    if len(bits) and not np.signbit(x).any():
-        return bits | SIGN
-    return np.where(bits >> np.uint64(63) == 1, ~bits, bits | SIGN)
+    k = np.bitwise_or(bits, SIGN, out=out)
+    negative = np.signbit(x)
+    if negative.any():
+        k[negative] = ~bits[negative]
+    return k
 
 
 def doubles(k):
@@ -73,40 +76,45 @@ class Summary:
     integer: bool
 
 
-def summary(x, integer, task):
-    """The Summary of a task's values x of a column (doubles, finite)."""
+def summary(x, integer, task, scratch):
+    """The Summary of a task's values x of a column (doubles, finite),
+    its temporaries computed in scratch (doubles, at least as many)."""
     mean = x.mean()
-    deviations = x - mean
+    deviations = np.subtract(x, mean, out=scratch[:len(x)])
     squares = float(np.square(deviations, out=deviations).sum())
-    k = key(x)
+    k = key(x, out=deviations.view(np.uint64))
     low, high = int(k.min()), int(k.max())
     shift = fitting_shift(low, high)
     first = low >> shift
-    bins = ((k >> np.uint64(shift)) - np.uint64(first)).astype(np.intp)
+    bins = np.subtract(np.right_shift(k, np.uint64(shift), out=k), np.uint64(first), out=k)
     return Summary({task: (len(x), float(mean), squares)}, float(x.min()), float(x.max()), shift, first,
-                   np.bincount(bins), integer)
+                   np.bincount(bins.view(np.int64)), integer)  # the bins are below 2^BITS: as signed, the same
 
 
 def reduced(columns, failed, task=0):
     """{column: Summary} of the numeric columns ({name: array}) of task
     `task` over the cases not failed (indices), where they have values (not
     NaN, not infinite)."""
+    n = len(next(iter(columns.values())))
     ok = None
     if len(failed):
-        ok = np.ones(len(next(iter(columns.values()))), dtype=bool)
+        ok = np.ones(n, dtype=bool)
         ok[failed] = False
+    # One array for every column's temporaries: a fresh array for each
+    # would come in fresh pages from the system, each page a fault.
+    scratch = np.empty(n)
     out = {}
     for name, x in columns.items():
         if x.dtype.kind not in "fi":
             continue
         integer = x.dtype.kind == "i"
-        x = x.astype(np.float64, copy=False)
+        x = np.ascontiguousarray(x, dtype=np.float64)
         if ok is not None:
             x = x[ok]
         if len(x) and not (np.isfinite(x.min()) and np.isfinite(x.max())):  # NaN or an infinity among them
             x = x[np.isfinite(x)]
         if len(x):
-            out[name] = summary(x, integer, task)
+            out[name] = summary(x, integer, task, scratch)
     return out
 
 

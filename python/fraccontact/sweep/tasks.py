@@ -122,29 +122,33 @@ def library_results(fixed, given, n):
     word, its checks), which would cost time beside every impact; a
     refused case's message is still fraccontact.impacts' own, from that
     case alone."""
-    shared = record(fixed, given)
     results = {name: np.empty(n) for name in model.IMPACT_FIGURES}
     results.update(impacts=np.empty(n, dtype=np.int64), steps=np.empty(n, dtype=np.int64), k=np.empty(n))
     status = np.empty(n, dtype=OUTCOME["status"])
+    # One batch and one outcome buffer for every call: only the given
+    # parameters change between calls, and the library writes every outcome.
+    batch, out = np.tile(record(fixed, given), min(CHUNK, n)), np.empty(min(CHUNK, n), dtype=OUTCOME)
+    figures = out["first"]
     cpu, a, b = 0.0, 0, min(FIRST, n)
     while a < n:
         if STATE["stop"]:
             raise RuntimeError("the sweep stopped")
-        batch = np.tile(shared, b - a)
+        m = b - a
         for name, x in given.items():
-            batch["v" if name == "height" else name] = velocities(x[a:b]) if name == "height" else x[a:b]
-        out = np.zeros(b - a, dtype=OUTCOME)
+            batch["v" if name == "height" else name][:m] = velocities(x[a:b]) if name == "height" else x[a:b]
         began = time.thread_time()
-        _lib.LIB.fc_run_batch(b - a, batch.ctypes.data, out.ctypes.data)
+        _lib.LIB.fc_run_batch(m, batch.ctypes.data, out.ctypes.data)
         spent = time.thread_time() - began
         cpu += spent
-        ended = out["impacts"] > 0
         for name in model.IMPACT_FIGURES:
-            results[name][a:b] = np.where(ended, out["first"][name], np.nan)
+            results[name][a:b] = figures[name][:m]
         for name in ("impacts", "steps", "k"):
-            results[name][a:b] = out[name]
-        status[a:b] = out["status"]
-        a, b = b, min(b + chunk(b - a, spent), n)
+            results[name][a:b] = out[name][:m]
+        status[a:b] = out["status"][:m]
+        a, b = b, min(b + chunk(m, spent), n)
+    unended = results["impacts"] <= 0  # no impact ended: its figures do not exist
+    for name in model.IMPACT_FIGURES:
+        results[name][unended] = np.nan
     refused = np.flatnonzero(status != _lib.FC_OK)
     results["k"][refused] = np.nan
     errors = {int(i): refusal({**fixed, **{name: x[i] for name, x in given.items()}}, status[i])
