@@ -626,6 +626,9 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
                  announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
+    /* a step of the energy account: the master's whole step (an early
+     * return's part is one), not the rest of a step cut inside the FMU */
+    const int accounted = !resume && proxy_striker(fm);
     const coupling_energy energy = fm->energy;
     const double correction = fm->correction;
     int from_prediction, other_coupling;
@@ -649,13 +652,13 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         fm->step_start = t;
         fm->step_H = H;
     }
-    if (!resume && proxy_striker(fm)) /* the inputs end the bodies' last interval */
+    if (accounted) /* the inputs end the bodies' last interval */
         coupling_energy_close(&fm->energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
     t_start = cm->s.t;
     v_end = cm->s.v;
     contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
                   fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
-    if (!resume && proxy_striker(fm))
+    if (accounted)
         coupling_energy_restart(&fm->energy, fm->coupling == COUPLING_JACOBI ? fm->owed : 0.0, cm->s.v - v_end);
     before = cm->s;
     save_memory(cm, &memory);
@@ -708,9 +711,9 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
      * this step, held. */
     predict(fm, fm->step_H);
     fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
-    if (proxy_striker(fm) && !resume) /* an early return's part is the master's whole step */
+    if (accounted)
         account_step(fm, part, &before, impulse, owed);
-    else { /* the rest of a step cut at an event inside the FMU: the step left out of the account */
+    else { /* no proxy, or the rest of a step cut at an event inside the FMU: left out of the account */
         fm->energy.open = 0;
         fm->correction = 0.0;
     }

@@ -197,7 +197,7 @@ MUTANTS = [
            "of the account",
            "+2.4e-3 E0 under a Gauss-Seidel master at H = 1 ms; "
            "test_two_bodies::test_an_early_returns_part_of_a_step_is_a_step_of_the_account: energy <= 1e-12",
-           (MODEL, "if (proxy_striker(fm) && !resume) /*", "if (proxy_striker(fm) && !resume && !*event) /*")),
+           (MODEL, "if (accounted)\n        account_step(", "if (accounted && !*event)\n        account_step(")),
     mutant("proxy-mass", "proxy striker", "the proxy striker's 1/m one ulp high",
            "1 ulp; test_fmu_coupling::test_mass_aware_coupling_with_an_exact_master_is_the_drop_test: bit for bit",
            (LIFE, "cm->inv_m = m > 0.0 ? 1.0 / m : 0.0;", "cm->inv_m = m > 0.0 ? nextafter(1.0 / m, 2.0 / m) : 0.0;")),
