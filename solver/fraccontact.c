@@ -207,6 +207,7 @@ static double contact_time(const fc_params *p)
     contact_model cm;
     double x_ref, t_ref, x_small;
     fc_model_params(p, &q);
+    q.damper = CONTACT_DAMPER_DASHPOT; /* the spring's alone: no springpot's memory to build */
     contact_start(&cm, &q, p->v, p->m);
     contact_scales(&q, contact_spring_stiffness(&cm, 0), p->v, p->m, &x_ref, &t_ref, &x_small);
     return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref : 0.0;
@@ -265,11 +266,9 @@ static double least_span(const fc_params *p, double *in_contact)
 static double least_steps(const fc_params *p)
 {
     contact_params q;
-    contact_model cm;
     double in_contact, span = least_span(p, &in_contact);
     fc_model_params(p, &q);
-    contact_start(&cm, &q, p->v, p->m);
-    return (contact_steps_uniformly(&cm) ? span : in_contact) / contact_step_limit(&q);
+    return (contact_steps_uniformly(&q) ? span : in_contact) / contact_step_limit(&q);
 }
 
 static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
@@ -530,7 +529,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     dt = contact_step_limit(&q);
     contact_start(&cm, &q, p->v, p->m);
     watch_run(w, &cm);
-    uniform = contact_steps_uniformly(&cm);
+    uniform = contact_steps_uniformly(&q);
     grid = rows_on_grid(&q);
     if (out)
         keep(out, &cm);

@@ -316,39 +316,118 @@ static void test_springpot_onset_step(void)
             contact_start(&cm, &p, v0, m);
             contact_advance_until(&cm, 1.0, CONTACT_ONSET);
             h = onset_step(&cm);
-            esdirk_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
+            radau_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
             CHECK(cm.s.in_contact && trial.error <= 1.0, "alpha %g, tolerance %g: the onset step %.3g errs %.3g",
                   alphas[i], tolerances[j], h, trial.error);
         }
 }
 
-/* Kvaerno's ESDIRK 5(4) (BIT 44 (2004) 489-502; ARKODE_KVAERNO_7_4_5), a
- * copy independent of esdirk54.c's, for taking its stages one by one. */
-static const double KVAERNO_A[7][7] = {
-    {0.0},
-    {0.26, 0.26},
-    {0.13, 0.8403332099679080963, 0.26},
-    {0.2237196147832050559, 0.4767553231979969983, -0.06470895363112615134, 0.26},
-    {0.1664856432324832153, 0.1045001884159172041, 0.03631482272098715162, -0.1309070445107399857, 0.26},
-    {0.1385564023126822495, 0.0, -0.04245337201752043099, 0.02446657898003141966, 0.6194303907248067618, 0.26},
-    {0.1365975117764029144, 0.0, -0.05496908796538376712, -0.04118626728321046868, 0.6299330489901640319,
-     0.06962479448202728949, 0.26}};
+/* Radau IIA with five stages, built here from its definition alone,
+ * independent of radau_iia.c's tables: its nodes are the roots of
+ * P_5(2x - 1) - P_4(2x - 1) (Legendre polynomials; Hairer and Wanner II,
+ * IV.5), each found by Newton's method from the table's value and checked
+ * to have moved by rounding only, and A_ij the integral of the j-th
+ * Lagrange polynomial on them from 0 to c_i, integrated exactly from its
+ * coefficients. */
+static double radau_polynomial(double x, double *slope)
+{
+    double p0 = 1.0, p1 = 2.0 * x - 1.0, d0 = 0.0, d1 = 2.0, p4 = 0.0, d4 = 0.0;
+    int n;
+    for (n = 1; n < 5; n++) { /* (n+1) P_(n+1) = (2n+1) y P_n - n P_(n-1), y = 2x - 1 */
+        const double y = 2.0 * x - 1.0;
+        const double p2 = ((2 * n + 1) * y * p1 - n * p0) / (n + 1);
+        const double d2 = ((2 * n + 1) * (2.0 * p1 + y * d1) - n * d0) / (n + 1);
+        p0 = p1, p1 = p2, d0 = d1, d1 = d2;
+        if (n == 3)
+            p4 = p1, d4 = d1;
+    }
+    *slope = d1 - d4;
+    return p1 - p4;
+}
+
+static void radau_tableau(double c[5], double A[5][5])
+{
+    static const double table[5] = {0.057104196114517683, 0.2768430136381238, 0.58359043236891683,
+                                    0.86024013565621948, 1.0};
+    int i, j, k, it;
+    for (i = 0; i < 5; i++) {
+        double x = table[i], slope;
+        for (it = 0; it < 5; it++)
+            x -= radau_polynomial(x, &slope) / slope;
+        CHECK(fabs(x - table[i]) <= 4.0 * DBL_EPSILON, "Radau node %d: %.17g is a root (%.17g)", i, table[i], x);
+        c[i] = x;
+    }
+    for (j = 0; j < 5; j++) {
+        double poly[5] = {1.0, 0.0, 0.0, 0.0, 0.0}; /* l_j's coefficients, lowest first */
+        int degree = 0;
+        for (k = 0; k < 5; k++) {
+            int m;
+            if (k == j)
+                continue;
+            for (m = ++degree; m >= 0; m--) /* times (t - c_k) / (c_j - c_k) */
+                poly[m] = ((m > 0 ? poly[m - 1] : 0.0) - c[k] * poly[m]) / (c[j] - c[k]);
+        }
+        for (i = 0; i < 5; i++) {
+            double integral = 0.0, power = c[i];
+            int m;
+            for (m = 0; m < 5; m++, power *= c[i])
+                integral += poly[m] * power / (m + 1);
+            A[i][j] = integral;
+        }
+    }
+}
+
+/* x := M^-1 x, Gaussian elimination with partial pivoting (n <= 5). */
+static void gauss(int n, double M[5][5], double x[5])
+{
+    int i, j, k;
+    for (k = 0; k < n; k++) {
+        int p = k;
+        for (i = k + 1; i < n; i++)
+            if (fabs(M[i][k]) > fabs(M[p][k]))
+                p = i;
+        for (j = 0; j < n; j++) {
+            const double t = M[k][j];
+            M[k][j] = M[p][j], M[p][j] = t;
+        }
+        {
+            const double t = x[k];
+            x[k] = x[p], x[p] = t;
+        }
+        for (i = k + 1; i < n; i++) {
+            const double f = M[i][k] / M[k][k];
+            for (j = k; j < n; j++)
+                M[i][j] -= f * M[k][j];
+            x[i] -= f * x[k];
+        }
+    }
+    for (k = n - 1; k >= 0; k--) {
+        for (j = k + 1; j < n; j++)
+            x[k] -= M[k][j] * x[j];
+        x[k] /= M[k][k];
+    }
+}
 
 /* After an accepted error-controlled springpot step each mode is the last
- * stage's, phi_i = (phi_n + h sum_{k<i} a_ik (z_k - b phi_k) + gamma h z_i) /
- * (1 + gamma h b) with the trial's rates z_k: esdirk_advance_modes takes it
- * as a polynomial in u from a table of the tableau's, which the stages taken
- * one by one here check, from the slowest mode to the stiffest and from a
- * step of a ns to one of 0.1 ms. Both round some 20 terms of up to 4 times
- * the mode's scale (|phi_n| and the travel h sum |z_k|), about 1e-14 of it at
- * worst (measured: below 1e-15 of it): 1e-13 of that scale. */
-static void test_esdirk_modes_are_the_last_stage(void)
+ * stage's: Phi solves (I + h b A) Phi = phi_n 1 + h A Z with the trial's
+ * stage rates Z, which radau_advance_modes takes through A's eigenbasis;
+ * solved here mode by mode from the tableau built above, from the slowest
+ * mode to the stiffest and from a step of a ns to one of 0.1 ms. Both
+ * round sums of terms up to about 50 times the mode's scale (|phi_n| and
+ * the travel h sum |Z|: the eigenbasis's last row reaches 50), some 1e-14
+ * of it: 1e-13 of that scale (measured: within 2.5e-14 of it). And the
+ * stages' elimination of the modes is consistent: the memory's force at
+ * the step's end from the advanced modes, c_alpha (eta z + sum a phi), is
+ * the spring's force there, to the rounding of those terms: 1e-13 of the
+ * memory's scale c_alpha sum |a phi| (measured: within 2.2e-14 of it). */
+static void test_radau_modes_are_the_last_stage(void)
 {
     static const double steps[] = {1e-9, 1e-6, 1e-5, 1e-4};
     contact_params p;
     contact_model cm, after;
-    double v0, m;
+    double v0, m, c[5], A[5][5];
     size_t i, j;
+    radau_tableau(c, A);
     contact_default_params(&p);
     contact_default_striker(&v0, &m);
     p.law = CONTACT_LAW_HERTZ;
@@ -360,32 +439,36 @@ static void test_esdirk_modes_are_the_last_stage(void)
     for (i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         const double h = steps[i];
         contact_state trial;
-        double z[7], travel = 0.0;
+        double Z[5], travel = 0.0, memory = 0.0, scale = 0.0, worst = 0.0;
         int k, s;
-        esdirk_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
-        z[0] = cm.s.x2_rate;
-        z[1] = trial.x2_rate1;
-        for (k = 0; k < 4; k++)
-            z[k + 2] = trial.x2_rate_inner[k];
-        z[6] = trial.x2_rate;
-        for (k = 0; k < 7; k++)
-            travel += h * fabs(z[k]);
+        radau_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
+        Z[0] = trial.x2_rate1;
+        for (k = 0; k < 3; k++)
+            Z[k + 1] = trial.x2_rate_inner[k];
+        Z[4] = trial.x2_rate;
+        for (k = 0; k < 5; k++)
+            travel += h * fabs(Z[k]);
         contact_copy(&after, &cm);
-        esdirk_advance_modes(&after, &trial);
+        radau_advance_modes(&after, &trial);
         for (j = 0; j < cm.modes.modes; j++) {
             const double b = cm.modes.b[j], phi_n = cm.modes.phi[j];
-            double phi[7];
-            phi[0] = phi_n;
-            for (s = 1; s < 7; s++) {
-                double E = phi_n;
-                for (k = 0; k < s; k++)
-                    E += h * KVAERNO_A[s][k] * (z[k] - b * phi[k]);
-                phi[s] = (E + 0.26 * h * z[s]) / (1.0 + 0.26 * h * b);
+            double M5[5][5], Phi[5];
+            for (s = 0; s < 5; s++) {
+                Phi[s] = phi_n;
+                for (k = 0; k < 5; k++) {
+                    M5[s][k] = (s == k) + h * b * A[s][k];
+                    Phi[s] += h * A[s][k] * Z[k];
+                }
             }
-            CHECK(fabs(after.modes.phi[j] - phi[6]) <= 1e-13 * (fabs(phi_n) + travel),
-                  "h = %g, mode %zu (b h = %.3g): %.17g against the stages' %.17g", h, j, b * h,
-                  after.modes.phi[j], phi[6]);
+            gauss(5, M5, Phi);
+            worst = fmax(worst, fabs(after.modes.phi[j] - Phi[4]) / (fabs(phi_n) + travel));
+            memory += cm.modes.a[j] * after.modes.phi[j];
+            scale += fabs(cm.modes.a[j] * after.modes.phi[j]);
         }
+        CHECK(worst <= 1e-13, "h = %g: the modes are the last stage's within %.2g of their scale", h, worst);
+        CHECK(fabs(p.c_alpha * (cm.modes.eta * trial.x2_rate + memory) - trial.F) <= 1e-13 * p.c_alpha * scale,
+              "h = %g: the memory's force %.17g is the spring's %.17g", h,
+              p.c_alpha * (cm.modes.eta * trial.x2_rate + memory), trial.F);
     }
 }
 
@@ -401,7 +484,7 @@ int main(void)
     test_gap_and_gravity();
     test_step_limit();
     test_springpot_onset_step();
-    test_esdirk_modes_are_the_last_stage();
+    test_radau_modes_are_the_last_stage();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

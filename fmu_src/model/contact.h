@@ -128,13 +128,12 @@ typedef struct {
     int in_contact;
     /* Not part of the state carried from step to step (so not listed
      * below): what a trial step leaves for accepting it, its length and
-     * the damper's rate x2' at its two stages (the second is the end's),
-     * and an error-controlled step's error over the tolerance; such a step
-     * of a springpot leaves x2' at its stages 2 to 5 too (of stages 0 to 6:
-     * stage 1's is x2_rate1, stage 6's x2_rate, the explicit stage 0's the
-     * start's). */
+     * the damper's rate x2' at its stages (the last is the end's), and an
+     * error-controlled step's error over the tolerance: SDIRK2's two
+     * stages in x2_rate1 and x2_rate, a springpot's Radau IIA step's five
+     * in x2_rate1, x2_rate_inner and x2_rate. */
     double step, x2_rate1, x2_rate, error;
-    double x2_rate_inner[4];
+    double x2_rate_inner[3];
 } contact_state;
 
 /* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,
@@ -354,10 +353,10 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
 int contact_check_history_span(const contact_params *p, double v, double m, double span, int until_first_separation,
                                const char *name, char *msg, size_t len);
 
-/* Whether the model steps on a uniform grid of dt_max whatever happens (the
+/* Whether a model of these parameters steps on a uniform grid of dt_max whatever happens (the
  * central scheme, the full G1 history): a caller advancing step by step
  * should then advance by dt_max. */
-int contact_steps_uniformly(const contact_model *cm);
+int contact_steps_uniformly(const contact_params *p);
 
 /* Driven scene: the indentation rate v from now on; m > 0 lets the model move
  * the striker with that inertia until the next call (a proxy striker), under

@@ -23,16 +23,19 @@ void resolve_contact(contact_model *cm);
 /* model.c */
 int memory_at_rest(const contact_model *cm);
 
-/* sdirk2.c and esdirk54.c: one step of length h from *in with spring
- * stiffness K into *out, returning the contact force's impulse; the
- * compressed memory after an accepted step. */
+/* sdirk2.c, esdirk54.c and radau_iia.c: one step of length h from *in
+ * with spring stiffness K into *out, returning the contact force's
+ * impulse; the compressed memory after an accepted step. */
 double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void advance_modes(contact_model *cm, double h, double z1, double z2);
 double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
-void esdirk_advance_modes(contact_model *cm, const contact_state *trial);
+double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+void radau_advance_modes(contact_model *cm, const contact_state *trial);
 
 /* control.c */
 double next_step(double h, double error, double least);
+double error_length(contact_model *cm, const contact_state *in, double K, const contact_state *out);
+double error_speed(const contact_state *in, const contact_state *out);
 double onset_step(const contact_model *cm);
 double recovery_step(const contact_model *cm, double remaining);
 
@@ -102,12 +105,24 @@ static inline double smaller(double a, double b) { return a < b ? a : b; }
 
 static inline int error_controlled(const contact_model *cm) { return cm->error_controlled; }
 
-/* Whether a step from *s is an ESDIRK step: error-controlled in contact.
- * Out of contact a recovering springpot takes recover's SDIRK2 steps, and
- * the onset search among them must take the same. */
-static inline int esdirk_steps(const contact_model *cm, const contact_state *s)
+/* Whether a step from *s is an error-controlled one: in contact. Out of
+ * contact a recovering springpot takes recover's SDIRK2 steps, and the
+ * onset search among them must take the same. */
+static inline int controlled_steps(const contact_model *cm, const contact_state *s)
 {
     return cm->error_controlled && s->in_contact;
+}
+
+/* An error-controlled step: the dashpot's ESDIRK, the compressed
+ * springpot's Radau IIA in contact and SDIRK2 out of it. */
+static inline double controlled_step(contact_model *cm, const contact_state *in, double h, double K,
+                                     contact_state *out)
+{
+    if (!springpot(cm))
+        return esdirk_step(cm, in, h, K, out);
+    if (!controlled_steps(cm, in))
+        return sdirk_step(cm, in, h, K, out);
+    return radau_step(cm, in, h, K, out);
 }
 
 static inline double indentation_rate(const contact_model *cm, const contact_state *s)
@@ -140,8 +155,8 @@ static inline void count_contact_step(contact_state *s, double peak)
 static inline void accept_step(contact_model *cm, const contact_state *trial)
 {
     if (compressed_memory(cm)) {
-        if (esdirk_steps(cm, trial))
-            esdirk_advance_modes(cm, trial);
+        if (controlled_steps(cm, trial))
+            radau_advance_modes(cm, trial);
         else
             advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
     }

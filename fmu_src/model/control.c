@@ -40,6 +40,35 @@ static double inverse_fifth_root(double x)
     return f * two_to_minus_fifths[e - 5 * q] * double_of((uint64_t)(1023 - q) << 52);
 }
 
+/* The elastic indentation at the contact's peak force so far, kept for the
+ * force it was derived from. */
+static double peak_indentation(contact_model *cm, double K, double F_peak)
+{
+    if (F_peak != cm->peak_force_seen) {
+        cm->peak_force_seen = F_peak;
+        cm->peak_length = K > 0.0 ? pow(F_peak / K, 1.0 / cm->p.spring_exponent) : 0.0;
+    }
+    return cm->peak_length;
+}
+
+/* The scale of a step's errors in x1 and x2: the larger of the elastic
+ * indentation at the step's ends and at the contact's peak force so far
+ * (relative in the force at onset, where x1^n is not smooth, grading the
+ * first steps). */
+double error_length(contact_model *cm, const contact_state *in, double K, const contact_state *out)
+{
+    double length = larger(larger(fabs(in->x1), fabs(out->x1)), DBL_MIN);
+    if (in->F_peak_contact > larger(in->F, out->F)) /* past the peak: its indentation is the larger */
+        length = larger(length, peak_indentation(cm, K, in->F_peak_contact));
+    return length;
+}
+
+/* The scale of a step's error in v: the speed at onset or now. */
+double error_speed(const contact_state *in, const contact_state *out)
+{
+    return larger(larger(fabs(in->v), fabs(out->v)), larger(fabs(in->v_onset), DBL_MIN));
+}
+
 /* The step after one of length h with error ratio `error` (error over
  * tolerance): the usual controller 0.9 error^(-1/5) (the embedded
  * solution's order is 4), growing at most 5-fold and shrinking at most to

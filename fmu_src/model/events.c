@@ -9,7 +9,7 @@
 /* A contact step of length h: error-controlled or fixed. */
 static double contact_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return error_controlled(cm) ? esdirk_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
+    return error_controlled(cm) ? controlled_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
 }
 
 /* Free flight is the parabola x1 + v t + a t^2 / 2 (x1 <= 0: the gap). The
@@ -206,7 +206,7 @@ double separation_within(contact_model *cm, const contact_state *s, double h, do
     int i;
     for (i = 0; i < 8; i++) {
         double rate, next;
-        *J = esdirk_step(cm, s, tau, K, trial);
+        *J = controlled_step(cm, s, tau, K, trial);
         rate = indentation_rate(cm, trial);
         if (trial->error > 1.0)
             return tau;

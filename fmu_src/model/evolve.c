@@ -81,7 +81,7 @@ static inline int controlled_internal_step(contact_model *cm, double remaining, 
         h = smaller(h, cm->h_max);
         /* the last step lands on the interval's end (forgiving a few ulp) */
         tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
-        J = esdirk_step(cm, s, tau, K, &trial);
+        J = controlled_step(cm, s, tau, K, &trial);
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
             tau = separation_within(cm, s, tau, K, &trial, &J);

@@ -67,7 +67,4 @@ double contact_step_limit(const contact_params *p)
     return contact_error_controlled(p) ? INFINITY : CONTACT_DEFAULT_STEP;
 }
 
-int contact_steps_uniformly(const contact_model *cm)
-{
-    return uniform_grid(&cm->p);
-}
+int contact_steps_uniformly(const contact_params *p) { return uniform_grid(p); }

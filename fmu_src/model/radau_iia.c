@@ -1,0 +1,424 @@
+/* Radau IIA with five stages, the springpot's error-controlled steps
+ * (docs/model.md §12): order 9 and stage order 5, so that the memory's
+ * stiff modes cost it little order, where an ESDIRK integrates them to its
+ * stage order 2 (docs/numerics.md). The modes are linear, so they are
+ * eliminated in the eigenbasis of the method's matrix A: per mode and
+ * trial three reciprocals of 1 + h b lambda, and the stages' unknowns are
+ * the five elastic indentations, solved together by Newton's method
+ * (E. Hairer and G. Wanner, Solving Ordinary Differential Equations II,
+ * IV.5 and IV.8; Guglielmi and Hairer integrate fractional ODEs as such
+ * stiff augmented systems with Radau IIA). */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "contact_internal.h"
+
+#define STAGES 5
+#define BLOCKS 3 /* A's eigenvalues: one real, two complex pairs */
+
+/* The collocation points, roots of d^4/dx^4 [x^4 (x - 1)^5], and
+ * A_ij = the integral of the j-th Lagrange polynomial on them from 0 to
+ * c_i; b, the weights, are A's last row (stiffly accurate). Computed to
+ * 50 digits; tests/test_contact.c checks the order conditions. */
+static const double radau_c[STAGES] = {0.057104196114517683, 0.2768430136381238, 0.58359043236891683,
+                                       0.86024013565621948, 1.0};
+static const double radau_a[STAGES][STAGES] = {
+    {0.072998864317903325, -0.02673533110794557, 0.018676929763984353, -0.01287910609330644, 0.0050428392338820148},
+    {0.15377523147918246, 0.14621486784749352, -0.036444568905128087, 0.021233063119304719, -0.007935579902728777},
+    {0.14006304568480987, 0.29896712949128346, 0.16758507013524895, -0.033969101686617743, 0.010944288744192253},
+    {0.14489430810953477, 0.2765000687601592, 0.32579792291042103, 0.12875675325490976, -0.015708917378805327},
+    {0.14371356079122594, 0.28135601514946207, 0.31182652297574126, 0.22310390108357075, 0.04}};
+
+/* A = T B T^-1 with B block diagonal: lambda_0, then [[re, im], [-im, re]]
+ * for each complex pair lambda_l = re + i im. A vector's coordinates are
+ * zeta_0 = (T^-1 x)_0 and zeta_l = (T^-1 x)_(2l-1) - i (T^-1 x)_(2l), on
+ * which any function of A acts as that function of lambda_l; the
+ * eigenvectors are scaled so that the vector of ones has every zeta 1. */
+static const double radau_lambda[BLOCKS][2] = {
+    {0.15906584442746913, 0.0}, {0.13317907701829959, 0.074994511835818525}, {0.065065778545743622, 0.11646852774031707}};
+static const double radau_t[STAGES][STAGES] = {
+    {0.59031650558899051, 0.51441981250440572, 0.75343357980300607, -0.10473631809339626, 0.36049927283828764},
+    {0.070345631821262938, 0.49274793822320861, -1.2058078883068759, 0.43690642995552847, -0.69695291339467547},
+    {3.4417503088721513, -0.6151696790367216, -4.1878747925368085, -1.8265806298354299, 0.66255230655653741},
+    {17.924721804569497, -19.571316494066576, -11.798905007960075, 2.6465946894970793, 3.7910402183761827},
+    {43.479581157478997, -50.158904417980807, -4.3745045874999935, 7.6793232605018105, 0.54714077253093052}};
+static const double radau_t_inverse[STAGES][STAGES] = {
+    {0.63702761246401196, 0.29400784393493457, 0.073793015049813379, -0.021883614950261514, 0.017055143501501606},
+    {0.63891143898260794, 0.36056128700872742, 0.0067098404943595697, 0.0061359004852347965, -0.012318466970929759},
+    {0.22740458813972847, -0.16193962965671202, -0.037588070025649151, -0.047685461016696643, 0.019808572559329343},
+    {0.65780527250968102, 0.63194417290698202, -0.38375611281535438, 0.12519519604682511, -0.0311885286481338},
+    {0.53493931080422219, -0.47389635647989797, -0.16334567709750378, 0.16311306633786865, -0.060810343564689069}};
+
+/* The embedded solution of order 5 (Hairer and Wanner IV.8): with
+ * gamma_0 = lambda_0, y_n + h (gamma_0 f(y_n) + sum bhat_j f(Y_j)), whose
+ * difference from the step's end is gamma_0 h f(y_n) + e . (Y - y_n),
+ * e = (bhat - b) A^-1; e's products with T's columns (its coordinates'
+ * weights) and its sum. */
+static const double radau_e[STAGES] = {-4.4189977167963814, 0.57923485225667004, -0.19923756095346801,
+                                       0.094167483691945483, -0.031813168885493827};
+static const double radau_e_t[STAGES] = {-2.9488838958995656, -2.1125062207358409, -4.1653916053844142,
+                                         1.0847440059486784, -1.789163750822806};
+#define RADAU_E_SUM (-3.9766461106867279)
+
+typedef struct {
+    double re, im;
+} complex_pair;
+
+static inline complex_pair times(complex_pair a, complex_pair b)
+{
+    complex_pair p = {a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re};
+    return p;
+}
+
+static inline complex_pair reciprocal(complex_pair a)
+{
+    const double n = 1.0 / (a.re * a.re + a.im * a.im);
+    complex_pair r = {a.re * n, -a.im * n};
+    return r;
+}
+
+/* A stage vector's coordinates, and back. */
+static void to_blocks(const double x[STAGES], complex_pair z[BLOCKS])
+{
+    double y[STAGES];
+    int i, k;
+    for (i = 0; i < STAGES; i++) {
+        y[i] = 0.0;
+        for (k = 0; k < STAGES; k++)
+            y[i] += radau_t_inverse[i][k] * x[k];
+    }
+    z[0].re = y[0];
+    z[0].im = 0.0;
+    z[1].re = y[1];
+    z[1].im = -y[2];
+    z[2].re = y[3];
+    z[2].im = -y[4];
+}
+
+static double from_blocks_at(const complex_pair z[BLOCKS], int i)
+{
+    return radau_t[i][0] * z[0].re + radau_t[i][1] * z[1].re - radau_t[i][2] * z[1].im + radau_t[i][3] * z[2].re
+           - radau_t[i][4] * z[2].im;
+}
+
+static void from_blocks(const complex_pair z[BLOCKS], double x[STAGES])
+{
+    int i;
+    for (i = 0; i < STAGES; i++)
+        x[i] = from_blocks_at(z, i);
+}
+
+/* The compressed memory's sums a trial needs, one pass over the modes:
+ * with d_l = 1/(1 + h b lambda_l) for each mode,
+ *     p_l = sum a phi d_l,  q_l = sum a d_l  (the stages' memory),
+ *     pp_0 = sum a phi d_0^2,  qq_0 = sum a d_0^2,  relaxed = sum a phi (1 - d_0)
+ * (the error estimate's, filtered through (I - gamma_0 h J)^-1, which
+ * needs d_0 d_l too: for l > 0 that is (lambda_0 d_0 - lambda_l d_l) /
+ * (lambda_0 - lambda_l), from p_0 and p_l). The three reciprocals by one
+ * division of their product, whose size, (h b)^5 at most, stays far from
+ * overflowing for any step and mode. */
+typedef struct {
+    complex_pair p[BLOCKS], q[BLOCKS];
+    double pp0, qq0, relaxed;
+} memory_sums;
+
+static void memory_sums_of(const contact_modes *m, double h, memory_sums *s)
+{
+    const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
+    const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
+    double p0 = 0.0, q0 = 0.0, pp0 = 0.0, qq0 = 0.0, relaxed = 0.0;
+    double p1r = 0.0, p1i = 0.0, q1r = 0.0, q1i = 0.0, p2r = 0.0, p2i = 0.0, q2r = 0.0, q2i = 0.0;
+    size_t j;
+    for (j = 0; j < m->modes; j++) {
+        const double x = h * m->b[j], a = m->a[j], ap = a * m->phi[j];
+        const double D0 = 1.0 + x * l0;
+        const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
+        const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
+        const double inv = 1.0 / (D0 * (N1 * N2));
+        const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
+        const double apd = ap * d0, ad = a * d0, ak1 = a * k1, apk1 = ap * k1, ak2 = a * k2, apk2 = ap * k2;
+        relaxed += apd * (x * l0);
+        p0 += apd;
+        q0 += ad;
+        pp0 += apd * d0;
+        qq0 += ad * d0;
+        p1r += apk1 * u1;
+        p1i -= apk1 * v1;
+        q1r += ak1 * u1;
+        q1i -= ak1 * v1;
+        p2r += apk2 * u2;
+        p2i -= apk2 * v2;
+        q2r += ak2 * u2;
+        q2i -= ak2 * v2;
+    }
+    s->p[0].re = p0, s->p[0].im = 0.0, s->q[0].re = q0, s->q[0].im = 0.0;
+    s->p[1].re = p1r, s->p[1].im = p1i, s->q[1].re = q1r, s->q[1].im = q1i;
+    s->p[2].re = p2r, s->p[2].im = p2i, s->q[2].re = q2r, s->q[2].im = q2i;
+    s->pp0 = pp0, s->qq0 = qq0, s->relaxed = relaxed;
+}
+
+/* sum a d_0 d_l y for l > 0 from the sums of a d_0 y and a d_l y. */
+static complex_pair with_d0(int l, double sum0, complex_pair sum_l)
+{
+    const complex_pair lam = {radau_lambda[l][0], radau_lambda[l][1]};
+    const complex_pair difference = {radau_lambda[0][0] - lam.re, -lam.im};
+    complex_pair num = times(lam, sum_l);
+    num.re = radau_lambda[0][0] * sum0 - num.re;
+    num.im = -num.im;
+    return times(num, reciprocal(difference));
+}
+
+/* x := M^-1 x for a 5 x 5 M, Gaussian elimination with partial pivoting
+ * (M is overwritten). */
+static void solve(double M[STAGES][STAGES], double x[STAGES])
+{
+    double inverse_pivot[STAGES];
+    int i, j, k;
+    for (k = 0; k < STAGES; k++) {
+        int p = k;
+        for (i = k + 1; i < STAGES; i++)
+            if (fabs(M[i][k]) > fabs(M[p][k]))
+                p = i;
+        if (p != k) {
+            double t;
+            for (j = k; j < STAGES; j++)
+                t = M[k][j], M[k][j] = M[p][j], M[p][j] = t;
+            t = x[k], x[k] = x[p], x[p] = t;
+        }
+        inverse_pivot[k] = 1.0 / M[k][k];
+        for (i = k + 1; i < STAGES; i++) {
+            const double f = M[i][k] * inverse_pivot[k];
+            for (j = k + 1; j < STAGES; j++)
+                M[i][j] -= f * M[k][j];
+            x[i] -= f * x[k];
+        }
+    }
+    for (k = STAGES - 1; k >= 0; k--) {
+        double s = x[k];
+        for (j = k + 1; j < STAGES; j++)
+            s -= M[k][j] * x[j];
+        x[k] = s * inverse_pivot[k];
+    }
+}
+
+/* The spring's force at an elastic indentation and its slope there. */
+static inline double force_and_slope(const contact_model *cm, double K, double X, double *slope)
+{
+    const double n = cm->p.spring_exponent;
+    if (!(X > 0.0)) {
+        *slope = 0.0;
+        return 0.0;
+    }
+    if (n == 1.5) {
+        const double s = sqrt(X);
+        *slope = 1.5 * K * s;
+        return K * X * s;
+    }
+    *slope = n * K * pow(X, n - 1.0);
+    return *slope * X / n;
+}
+
+/* A Newton iteration that changed no indentation by more than this part of
+ * the largest leaves them exact to rounding (its error about the square of
+ * the last correction); a trial that needs more than NEWTON_LIMIT is
+ * rejected, and the step shrinks. */
+#define NEWTON_SETTLED 1e-8
+#define NEWTON_LIMIT 30
+
+/* The stages' elastic indentations X from X + G F(X) = r, G = T diag(mu)
+ * T^-1: Newton's method from the start's motion. 0 when it did not
+ * converge. */
+static int stage_indentations(const contact_model *cm, double K, const complex_pair mu[BLOCKS],
+                              const double r[STAGES], double X[STAGES], double F[STAGES])
+{
+    double G[STAGES][STAGES];
+    int i, k, it;
+    for (i = 0; i < STAGES; i++) {
+        double Tm[STAGES]; /* row i of T diag(mu) in the coordinates */
+        int l;
+        Tm[0] = radau_t[i][0] * mu[0].re;
+        for (l = 1; l < BLOCKS; l++) {
+            const double tr = radau_t[i][2 * l - 1], ti = radau_t[i][2 * l];
+            Tm[2 * l - 1] = tr * mu[l].re - ti * mu[l].im;
+            Tm[2 * l] = tr * mu[l].im + ti * mu[l].re;
+        }
+        for (k = 0; k < STAGES; k++) {
+            double g = 0.0;
+            int c;
+            for (c = 0; c < STAGES; c++)
+                g += Tm[c] * radau_t_inverse[c][k];
+            G[i][k] = g;
+        }
+    }
+    for (it = 0; it < NEWTON_LIMIT; it++) {
+        double J[STAGES][STAGES], R[STAGES], slope[STAGES], change = 0.0, scale = DBL_MIN;
+        for (i = 0; i < STAGES; i++)
+            F[i] = force_and_slope(cm, K, X[i], &slope[i]);
+        for (i = 0; i < STAGES; i++) {
+            R[i] = r[i] - X[i];
+            for (k = 0; k < STAGES; k++) {
+                R[i] -= G[i][k] * F[k];
+                J[i][k] = G[i][k] * slope[k] + (i == k);
+            }
+        }
+        solve(J, R);
+        for (i = 0; i < STAGES; i++) {
+            X[i] += R[i];
+            change = larger(change, fabs(R[i]));
+            scale = larger(scale, fabs(X[i]));
+        }
+        if (!(change > NEWTON_SETTLED * scale)) {
+            for (i = 0; i < STAGES; i++)
+                F[i] = force_and_slope(cm, K, X[i], &slope[i]);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The embedded error estimate (see radau_e), filtered through
+ * (I - gamma_0 h J)^-1 with the Jacobian at the step's start, J's modes
+ * eliminated as in the stages: the errors of x1, v, x2 and of the memory's
+ * force sum a phi, over the tolerance's scales (error_scale). */
+typedef struct {
+    double x1, v, x2, memory;
+} radau_errors;
+
+static radau_errors filtered_errors(const contact_model *cm, const contact_state *in, double h, double K,
+                                    const memory_sums *s, const double X[STAGES], const double V[STAGES],
+                                    const double travel[STAGES], const complex_pair W[BLOCKS])
+{
+    const double w = radau_lambda[0][0] * h, c_alpha = cm->p.c_alpha, inv_m = cm->inv_m, z_n = in->x2_rate;
+    double r_x1 = w * (in->v - z_n), r_v = w * (cm->accel - inv_m * in->F), r_x2 = w * z_n, rho, kk, slope, ex1, dz;
+    radau_errors e;
+    int i, l;
+    for (i = 0; i < STAGES; i++) {
+        r_x1 += radau_e[i] * (X[i] - in->x1);
+        r_v += radau_e[i] * (V[i] - in->v);
+        r_x2 += radau_e[i] * travel[i];
+    }
+    /* sum a d_0 r_phi with r_phi = w (z_n - b phi) + e . (Phi - phi) */
+    rho = w * z_n * s->q[0].re - s->relaxed - RADAU_E_SUM * s->p[0].re;
+    for (l = 0; l < BLOCKS; l++) {
+        const complex_pair e_l = {radau_e_t[l == 0 ? 0 : 2 * l - 1], l == 0 ? 0.0 : radau_e_t[2 * l]};
+        const complex_pair pp = l == 0 ? (complex_pair){s->pp0, 0.0} : with_d0(l, s->p[0].re, s->p[l]);
+        const complex_pair qq = l == 0 ? (complex_pair){s->qq0, 0.0} : with_d0(l, s->q[0].re, s->q[l]);
+        complex_pair sum = times(W[l], qq);
+        sum.re += pp.re;
+        sum.im += pp.im;
+        rho += times(e_l, sum).re;
+    }
+    kk = 1.0 / (cm->modes.eta + w * s->q[0].re);
+    force_and_slope(cm, K, in->x1, &slope);
+    ex1 = (r_x1 + w * kk * rho + w * r_v) / (1.0 + w * kk * slope / c_alpha + w * w * slope * inv_m);
+    dz = kk * (slope * ex1 / c_alpha - rho);
+    e.x1 = ex1;
+    e.v = r_v - w * slope * inv_m * ex1;
+    e.x2 = r_x2 + w * dz;
+    /* the memory's force error as the travel it drives over the step
+     * through the stage's viscosity c_alpha / kk */
+    e.memory = h * kk * (rho + w * dz * s->q[0].re);
+    return e;
+}
+
+double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    const double c_alpha = cm->p.c_alpha, eta = cm->modes.eta, inv_m = cm->inv_m, accel = cm->accel;
+    memory_sums s;
+    complex_pair ell[BLOCKS], mu[BLOCKS], pull[BLOCKS], Ft[BLOCKS], Zt[BLOCKS], W[BLOCKS];
+    double r[STAGES], X[STAGES], F[STAGES], V[STAGES], Z[STAGES], travel[STAGES];
+    double impulse = 0.0, work = 0.0, error;
+    radau_errors e;
+    int i, k, l;
+    memory_sums_of(&cm->modes, h, &s);
+    for (l = 0; l < BLOCKS; l++) {
+        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+        complex_pair den = times(hl, s.q[l]), hl_ell;
+        den.re += eta;
+        ell[l] = reciprocal(den);
+        hl_ell = times(hl, ell[l]);
+        mu[l] = times(hl, hl);
+        mu[l].re = mu[l].re * inv_m + hl_ell.re / c_alpha;
+        mu[l].im = mu[l].im * inv_m + hl_ell.im / c_alpha;
+        pull[l] = times(hl_ell, s.p[l]);
+    }
+    for (i = 0; i < STAGES; i++) {
+        const double ch = radau_c[i] * h;
+        r[i] = in->x1 + ch * (in->v + 0.5 * ch * accel) + from_blocks_at(pull, i);
+        X[i] = in->x1 + ch * (in->v - in->x2_rate);
+    }
+    *out = *in;
+    out->t = in->t + h;
+    out->step = h;
+    if (!stage_indentations(cm, K, mu, r, X, F)) {
+        out->error = INFINITY;
+        return 0.0;
+    }
+    to_blocks(F, Ft);
+    for (l = 0; l < BLOCKS; l++) {
+        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+        complex_pair force = {Ft[l].re / c_alpha - s.p[l].re, Ft[l].im / c_alpha - s.p[l].im};
+        Zt[l] = times(ell[l], force);
+        W[l] = times(hl, Zt[l]);
+    }
+    from_blocks(Zt, Z);
+    from_blocks(W, travel);
+    for (i = 0; i < STAGES; i++) {
+        double AF = 0.0;
+        for (k = 0; k < STAGES; k++)
+            AF += radau_a[i][k] * F[k];
+        V[i] = in->v + h * (radau_c[i] * accel - inv_m * AF);
+        impulse += h * radau_a[STAGES - 1][i] * F[i];
+        work += h * radau_a[STAGES - 1][i] * F[i] * Z[i];
+    }
+    e = filtered_errors(cm, in, h, K, &s, X, V, travel, W);
+    out->x1 = X[STAGES - 1];
+    out->v = V[STAGES - 1];
+    out->F = F[STAGES - 1];
+    out->x2 = in->x2 + travel[STAGES - 1];
+    out->E_diss = in->E_diss + work;
+    out->x2_rate1 = Z[0];
+    memcpy(out->x2_rate_inner, Z + 1, sizeof out->x2_rate_inner);
+    out->x2_rate = Z[STAGES - 1];
+    error = larger(larger(fabs(e.x1), fabs(e.x2)), fabs(e.memory)) / error_length(cm, in, K, out);
+    out->error = larger(error, fabs(e.v) / error_speed(in, out)) / cm->p.tolerance;
+    return impulse;
+}
+
+/* The modes after an accepted step: the last stage's (stiffly accurate),
+ * Phi = (I + h b A)^-1 (phi_n 1 + h A Z) in the coordinates, from the
+ * trial's stage rates Z. */
+void radau_advance_modes(contact_model *cm, const contact_state *trial)
+{
+    contact_modes *m = &cm->modes;
+    const double h = trial->step;
+    double Z[STAGES];
+    complex_pair Zt[BLOCKS], W[BLOCKS], tau[BLOCKS], tau_W[BLOCKS];
+    size_t j;
+    int l;
+    Z[0] = trial->x2_rate1;
+    memcpy(Z + 1, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
+    Z[STAGES - 1] = trial->x2_rate;
+    to_blocks(Z, Zt);
+    for (l = 0; l < BLOCKS; l++) {
+        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+        W[l] = times(hl, Zt[l]);
+    }
+    for (l = 0; l < BLOCKS; l++) { /* the last row's weights on each coordinate */
+        const complex_pair last = {radau_t[STAGES - 1][l == 0 ? 0 : 2 * l - 1], l == 0 ? 0.0 : radau_t[STAGES - 1][2 * l]};
+        tau[l] = last;
+        tau_W[l] = times(last, W[l]);
+    }
+    for (j = 0; j < m->modes; j++) {
+        const double x = h * m->b[j], phi = m->phi[j];
+        const double D0 = 1.0 + x * radau_lambda[0][0];
+        const double u1 = 1.0 + x * radau_lambda[1][0], v1 = x * radau_lambda[1][1], N1 = u1 * u1 + v1 * v1;
+        const double u2 = 1.0 + x * radau_lambda[2][0], v2 = x * radau_lambda[2][1], N2 = u2 * u2 + v2 * v2;
+        /* Re(tau (phi + W) / s) = Re(tau (phi + W) conj(s)) / |s|^2 for s = 1 + x lambda */
+        const double n0 = phi * tau[0].re + tau_W[0].re;
+        const double n1 = (phi * tau[1].re + tau_W[1].re) * u1 + (phi * tau[1].im + tau_W[1].im) * v1;
+        const double n2 = (phi * tau[2].re + tau_W[2].re) * u2 + (phi * tau[2].im + tau_W[2].im) * v2;
+        m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));
+    }
+}
