@@ -173,8 +173,9 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, esdirk54 (error-controlled steps, tolerance > 0), central, g1_history (a\n"
-           "               springpot's full G1 history) or reference; the spring constant used [N/m^n]\n"
+           "  method, k    sdirk2, esdirk54 or radau_iia (error-controlled steps, tolerance > 0: the dashpot's,\n"
+           "               the springpot's), central, g1_history (a springpot's full G1 history) or\n"
+           "               reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"
            "Exit status: 0 done, 2 bad options, 1 the solve or an output failed, 130 interrupted (Ctrl-C).\n"
            "On a terminal a solve that takes more than a few seconds shows its progress on stderr.\n");

@@ -39,7 +39,8 @@ CLASSES = [  # (parameters, the method docs/model.md §16 gives them)
     (dict(scheme="central"), "central"),
     (dict(scheme="central", law=2, tolerance=1e-6), "central"),
     (dict(SPRINGPOT, memory="compressed"), "sdirk2"),
-    (dict(SPRINGPOT, memory="compressed", law=2, tolerance=1e-6), "esdirk54"),
+    (dict(SPRINGPOT, memory="compressed", law=2, tolerance=1e-6), "radau_iia"),
+    (dict(SPRINGPOT, memory="compressed", law=1, g1_nodes=100, tolerance=1e-6), "radau_iia"),
     (dict(SPRINGPOT, memory="full"), "g1_history"),
     (dict(SPRINGPOT, memory="full", law=2, tolerance=1e-6), "g1_history"),
 ]

@@ -547,7 +547,7 @@ static void predict(fmu_model *fm, double H)
     /* The full G1 history's struct copy shares its buffer: room for the
      * predicted steps first, so that the copy never reallocates it. */
     if (contact_check_advance(cm, H, why, sizeof why) != 0
-        || (contact_steps_uniformly(cm)
+        || (contact_steps_uniformly(&cm->p)
             && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->h_max + 0.5)) != 0))
         return;
     contact_copy(&p->model, cm);
@@ -636,7 +636,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     /* A refused step changes nothing, so the checks come first: a uniform
      * grid's steps are known in advance (the others' are counted as they
      * are taken: MAX_STEPS, the model's max_steps). */
-    if (contact_steps_uniformly(cm) && H / cm->h_max > MAX_STEPS)
+    if (contact_steps_uniformly(&cm->p) && H / cm->h_max > MAX_STEPS)
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: communicationStepSize = %g takes more than 1e9 internal steps of dt_max = %g s on "
                       "the uniform grid; take shorter communication steps or a larger dt_max", H, cm->h_max);

@@ -72,9 +72,10 @@ enum contact_memory {
  * contact_method alone, and named by contact_method_name. */
 enum contact_method {
     CONTACT_METHOD_SDIRK2 = 1,     /* fixed steps: SDIRK2 (sdirk2.c) */
-    CONTACT_METHOD_ESDIRK54 = 2,   /* error-controlled steps, tolerance > 0: ESDIRK 5(4) (esdirk54.c) */
+    CONTACT_METHOD_ESDIRK54 = 2,   /* error-controlled steps of the dashpot, tolerance > 0: ESDIRK 5(4) (esdirk54.c) */
     CONTACT_METHOD_G1_HISTORY = 3, /* the springpot's full G1 history, BDF2 on a uniform grid (g1_history.c) */
-    CONTACT_METHOD_CENTRAL = 4     /* the paper's central differences on a uniform grid (central.c) */
+    CONTACT_METHOD_CENTRAL = 4,    /* the paper's central differences on a uniform grid (central.c) */
+    CONTACT_METHOD_RADAU_IIA = 5   /* error-controlled steps of the compressed springpot: Radau IIA (radau_iia.c) */
 };
 
 enum contact_scene {
@@ -272,7 +273,7 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
 /* The method these parameters run (docs/model.md §16), and its name:
- * "sdirk2", "esdirk54", "g1_history" or "central". */
+ * "sdirk2", "esdirk54", "radau_iia", "g1_history" or "central". */
 enum contact_method contact_method(const contact_params *p);
 const char *contact_method_name(enum contact_method method);
 

@@ -188,7 +188,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
                       || (cm->poll && cm->s.steps % CONTACT_POLL_STEPS == 0 && cm->poll(cm->poll_ctx));
             continue;
         }
-        if (method == CONTACT_METHOD_ESDIRK54) {
+        if (method == CONTACT_METHOD_ESDIRK54 || method == CONTACT_METHOD_RADAU_IIA) {
             double advanced = 0.0;
             int status;
             cm->s.steps++;

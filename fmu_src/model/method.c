@@ -1,7 +1,8 @@
 /* Which method a configuration runs, decided here alone (docs/model.md
  * §16): the springpot's full G1 history steps by its own BDF2 scheme, the
  * central scheme by the paper's central differences, error-controlled steps
- * by ESDIRK 5(4), fixed ones by SDIRK2. */
+ * by ESDIRK 5(4) (the dashpot) or Radau IIA (the compressed springpot),
+ * fixed ones by SDIRK2. */
 #include <math.h>
 #include <stddef.h>
 
@@ -21,7 +22,7 @@ enum contact_method contact_method(const contact_params *p)
     if (p->scheme == CONTACT_SCHEME_CENTRAL)
         return CONTACT_METHOD_CENTRAL;
     if (p->tolerance > 0.0 && !law_counts_steps(p))
-        return CONTACT_METHOD_ESDIRK54;
+        return p->damper == CONTACT_DAMPER_SPRINGPOT ? CONTACT_METHOD_RADAU_IIA : CONTACT_METHOD_ESDIRK54;
     return CONTACT_METHOD_SDIRK2;
 }
 
@@ -32,6 +33,8 @@ const char *contact_method_name(enum contact_method method)
         return "sdirk2";
     case CONTACT_METHOD_ESDIRK54:
         return "esdirk54";
+    case CONTACT_METHOD_RADAU_IIA:
+        return "radau_iia";
     case CONTACT_METHOD_G1_HISTORY:
         return "g1_history";
     case CONTACT_METHOD_CENTRAL:
@@ -58,7 +61,11 @@ const char *fixed_steps_only(const contact_params *p)
     return NULL;
 }
 
-int contact_error_controlled(const contact_params *p) { return contact_method(p) == CONTACT_METHOD_ESDIRK54; }
+int contact_error_controlled(const contact_params *p)
+{
+    const enum contact_method method = contact_method(p);
+    return method == CONTACT_METHOD_ESDIRK54 || method == CONTACT_METHOD_RADAU_IIA;
+}
 
 double contact_step_limit(const contact_params *p)
 {

@@ -130,6 +130,7 @@ static void memory_sums_of(const contact_modes *m, double h, memory_sums *s)
     double p0 = 0.0, q0 = 0.0, pp0 = 0.0, qq0 = 0.0, relaxed = 0.0;
     double p1r = 0.0, p1i = 0.0, q1r = 0.0, q1i = 0.0, p2r = 0.0, p2i = 0.0, q2r = 0.0, q2i = 0.0;
     size_t j;
+#pragma omp simd reduction(+ : p0, q0, pp0, qq0, relaxed, p1r, p1i, q1r, q1i, p2r, p2i, q2r, q2i)
     for (j = 0; j < m->modes; j++) {
         const double x = h * m->b[j], a = m->a[j], ap = a * m->phi[j];
         const double D0 = 1.0 + x * l0;

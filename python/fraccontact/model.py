@@ -28,7 +28,7 @@ scipy's OptimizeResult.
              impacts, steps, k: finished impacts, internal steps, the spring
                constant used;
              method: the method that ran, as the model names it (sdirk2,
-               esdirk54, g1_history, central; docs/model.md §16).
+               esdirk54, radau_iia, g1_history, central; docs/model.md §16).
   Series   what simulate() returns: the columns t, F, x, x1, x2, v, E_diss
            (arrays, SI units), and run, the Run impact() gives for the same
            parameters.
@@ -321,7 +321,7 @@ class Run(_Record):
     impacts: int      # finished impacts
     steps: int        # internal steps
     k: float          # the spring constant used (given, or derived) [N/m^n]
-    method: str       # the method that ran: sdirk2, esdirk54, g1_history or central
+    method: str       # the method that ran: sdirk2, esdirk54, radau_iia, g1_history or central
 
 
 @dataclass

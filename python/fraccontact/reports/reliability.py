@@ -24,7 +24,7 @@ ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
                "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
     f"fmu_src/model/{name}.c" for name in ("parameters", "method", "resolution", "model", "stage", "sdirk2",
-                                           "esdirk54", "control", "events", "evolve", "g1_history", "central")]
+                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central")]
 
 
 def sh(*args, **kw):
