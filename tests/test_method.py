@@ -4,8 +4,8 @@
 configuration class maps to the method the rules of §16 give it, and the
 steps taken show that method ran: the uniform grids step through the
 flight to the specimen one dt_max at a time, SDIRK2 flies in one exact
-step and then takes fixed steps in contact, ESDIRK 5(4) takes the few
-steps its controller allows."""
+step and then takes fixed steps in contact, ESDIRK 5(4) and Radau IIA
+take the few steps their controller allows."""
 
 import json
 import os

@@ -1,5 +1,5 @@
 """Error-controlled internal steps (`tolerance` > 0): Kvaerno's 5(4) ESDIRK
-against scipy's solution of the same ODE (independent of the C code), the
+(the dashpot) and Radau IIA (the springpot) against scipy's solution of the same ODE (independent of the C code), the
 momentum and energy identities, the FMU at a communication step, bad values,
 and the laws and scenes it applies to; the springpot's compressed memory
 against its full G1 history."""

@@ -71,8 +71,8 @@ def mutant(name, category, change, claim, *edits):
 G1, MODEL, STATE, INSTANCE = \
     "fmu_src/model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
 # The model's files (fmu_src/model/): one responsibility each.
-PARAMETERS, LIFE, STAGE, SDIRK2, EVENTS, EVOLVE, PASSIVITY = ("fmu_src/model/" + f for f in (
-    "parameters.c", "model.c", "stage.h", "sdirk2.c", "events.c", "evolve.c", "passivity.c"))
+PARAMETERS, LIFE, STAGE, SDIRK2, RADAU, EVENTS, EVOLVE, PASSIVITY = ("fmu_src/model/" + f for f in (
+    "parameters.c", "model.c", "stage.h", "sdirk2.c", "radau_iia.c", "events.c", "evolve.c", "passivity.c"))
 CONTACT_H = "fmu_src/model/contact.h"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
@@ -147,6 +147,21 @@ MUTANTS = [
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
            "N = 10 steps per 1 us",
            (EVOLVE, "(1.0 - 1e-12)));", "(1.0 + 1e-12)));")),
+    mutant("radau-eigenvalue", "time scheme", "Radau IIA: A's real eigenvalue ×(1 + 1e-11) in the modes' elimination",
+           "each mode's 1/(1 + h b λ) off by up to 1e-11; test_contact test_radau_modes_are_the_last_stage: "
+           "the advanced modes against the last stage solved from A built anew, 1e-13 of their scale",
+           (RADAU, "{0.15906584442746913, 0.0}, {0.13317907701829959",
+            "{0.15906584442746913 * (1.0 + 1e-11), 0.0}, {0.13317907701829959")),
+    mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update without the second complex pair",
+           STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage",
+           (RADAU, "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));",
+            "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2)) / (D0 * (N1 * N2));")),
+    mutant("radau-estimate-memory", "time scheme", "Radau IIA: the error estimate's filter without the modes' own "
+           "residuals",
+           "the estimate changes, and with it the steps; test_claims::test_the_springpot_table_of_error_controlled_steps: "
+           "the steps of docs/numerics.md's springpot table exactly",
+           (RADAU, "    kk = 1.0 / (cm->modes.eta + w * s->q[0].re);",
+            "    rho = 0.0;\n    kk = 1.0 / (cm->modes.eta + w * s->q[0].re);")),
     # ----------------------------------------------------------------- events
     mutant("onset-location", "events", "contact onset inside a free-flight step: time ×(1 + 3e-14)",
            "3e-14; test_solver::test_free_flight_is_one_exact_step: t_onset, v_onset rel 1e-14",

@@ -78,7 +78,7 @@ LAWS = ("g1", "hertz", ADAPTIVE)
 # `tolerance` relative to the elastic indentation L (the larger of x1 and
 # x1 at the contact's peak force) for x1 and x2 and relative to the speed S
 # (the larger of |v| and v_onset) for v (fmu_src/model/esdirk54.c,
-# esdirk_step_of), and the separation is located to a tenth of the tolerance
+# esdirk_step), and the separation is located to a tenth of the tolerance
 # of the contact time. The 5th-order solution is propagated, whose local
 # error is below the 4th-order estimate's, and over an impact (at most half
 # a damped oscillation) the motion hardly amplifies errors, so a figure's
