@@ -152,10 +152,11 @@ MUTANTS = [
            "the advanced modes against the last stage solved from A built anew, 1e-13 of their scale",
            (RADAU, "{0.15906584442746913, 0.0}, {0.13317907701829959",
             "{0.15906584442746913 * (1.0 + 1e-11), 0.0}, {0.13317907701829959")),
-    mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update without the second complex pair",
+    mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update divides the second complex pair's "
+           "term by the wrong pair's modulus",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage",
            (RADAU, "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));",
-            "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2)) / (D0 * (N1 * N2));")),
+            "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N2)) / (D0 * (N1 * N2));")),
     mutant("radau-estimate-memory", "time scheme", "Radau IIA: the error estimate's filter without the modes' own "
            "residuals",
            "the estimate changes, and with it the steps; test_claims::test_the_springpot_table_of_error_controlled_steps: "
