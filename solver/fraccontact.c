@@ -30,8 +30,8 @@ static const fc_parameter parameters[] = {
      "relative error of the compressed memory's kernel, from the fixed step (error-controlled steps: from min(dt_max, "
      "1e-9 s)) to 1000 s (memory 2)"},
     {"tolerance", FC_REAL, AT(tolerance), "1",
-     "relative error per internal step (error-controlled ESDIRK steps, capped by dt_max only when dt_max > 0); 0 = "
-     "fixed steps of dt_max"},
+     "relative error per internal step (error-controlled steps, ESDIRK 5(4) or the springpot's Radau IIA, capped by "
+     "dt_max only when dt_max > 0); 0 = fixed steps of dt_max"},
     {"dt_max", FC_REAL, AT(dt_max), "s",
      "largest internal step; 0 = fixed steps of 1e-7 s and no cap on error-controlled steps; in contact, where fewer "
      "than 6 fixed steps would fit in the time the spring takes to stop the striker, they are 4000 in that time"},
@@ -326,8 +326,9 @@ fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, si
  * about one unit more per this many of them. */
 #define HISTORY_PER_UNIT 64
 
-/* An error-controlled step (ESDIRK, seven stages) costs about this many
- * units. */
+/* An error-controlled step costs about this many units: the dashpot's
+ * ESDIRK (seven stages) fewer, the springpot's Radau IIA (five coupled
+ * stages and two passes over the modes) more. */
 #define CONTROLLED_STEP_UNITS 4
 
 typedef struct {

@@ -36,7 +36,8 @@ static const double radau_a[STAGES][STAGES] = {
  * which any function of A acts as that function of lambda_l; the
  * eigenvectors are scaled so that the vector of ones has every zeta 1. */
 static const double radau_lambda[BLOCKS][2] = {
-    {0.15906584442746913, 0.0}, {0.13317907701829959, 0.074994511835818525}, {0.065065778545743622, 0.11646852774031707}};
+    {0.15906584442746913, 0.0}, {0.13317907701829959, 0.074994511835818525},
+    {0.065065778545743622, 0.11646852774031707}};
 static const double radau_t[STAGES][STAGES] = {
     {0.59031650558899051, 0.51441981250440572, 0.75343357980300607, -0.10473631809339626, 0.36049927283828764},
     {0.070345631821262938, 0.49274793822320861, -1.2058078883068759, 0.43690642995552847, -0.69695291339467547},
@@ -395,21 +396,19 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     contact_modes *m = &cm->modes;
     const double h = trial->step;
     double Z[STAGES];
-    complex_pair Zt[BLOCKS], W[BLOCKS], tau[BLOCKS], tau_W[BLOCKS];
+    complex_pair Zt[BLOCKS], tau[BLOCKS], tau_W[BLOCKS];
     size_t j;
     int l;
     Z[0] = trial->x2_rate1;
     memcpy(Z + 1, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
     Z[STAGES - 1] = trial->x2_rate;
     to_blocks(Z, Zt);
-    for (l = 0; l < BLOCKS; l++) {
+    for (l = 0; l < BLOCKS; l++) { /* the last row's weights on each coordinate, and on h lambda Z~ */
         const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
-        W[l] = times(hl, Zt[l]);
-    }
-    for (l = 0; l < BLOCKS; l++) { /* the last row's weights on each coordinate */
-        const complex_pair last = {radau_t[STAGES - 1][l == 0 ? 0 : 2 * l - 1], l == 0 ? 0.0 : radau_t[STAGES - 1][2 * l]};
+        const complex_pair last = {radau_t[STAGES - 1][l == 0 ? 0 : 2 * l - 1],
+                                   l == 0 ? 0.0 : radau_t[STAGES - 1][2 * l]};
         tau[l] = last;
-        tau_W[l] = times(last, W[l]);
+        tau_W[l] = times(last, times(hl, Zt[l]));
     }
     for (j = 0; j < m->modes; j++) {
         const double x = h * m->b[j], phi = m->phi[j];
