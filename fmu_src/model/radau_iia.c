@@ -204,21 +204,18 @@ static void solve(double M[STAGES][STAGES], double x[STAGES])
     }
 }
 
-/* The spring's force at an elastic indentation and its slope there. */
+/* The spring's force at an elastic indentation, and its slope there,
+ * n F / X for F = K X^n. */
 static inline double force_and_slope(const contact_model *cm, double K, double X, double *slope)
 {
-    const double n = cm->p.spring_exponent;
+    double F;
     if (!(X > 0.0)) {
         *slope = 0.0;
         return 0.0;
     }
-    if (n == 1.5) {
-        const double s = sqrt(X);
-        *slope = 1.5 * K * s;
-        return K * X * s;
-    }
-    *slope = n * K * pow(X, n - 1.0);
-    return *slope * X / n;
+    F = spring_force(cm, K, X);
+    *slope = cm->p.spring_exponent * F / X;
+    return F;
 }
 
 /* A Newton iteration that changed no indentation by more than this part of
