@@ -79,6 +79,21 @@ static inline complex_pair reciprocal(complex_pair a)
     return r;
 }
 
+/* h lambda_l. */
+static inline complex_pair h_lambda(double h, int l)
+{
+    complex_pair z = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+    return z;
+}
+
+/* The weights a row vector w puts on the coordinates: w . x = Re sum_l
+ * weight_l zeta_l (w . T's columns, each pair as one complex number). */
+static inline complex_pair coordinate_weight(const double w_t[STAGES], int l)
+{
+    complex_pair z = {w_t[l == 0 ? 0 : 2 * l - 1], l == 0 ? 0.0 : w_t[2 * l]};
+    return z;
+}
+
 /* A stage vector's coordinates, and back. */
 static void to_blocks(const double x[STAGES], complex_pair z[BLOCKS])
 {
@@ -279,7 +294,7 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
 /* The embedded error estimate (see radau_e), filtered through
  * (I - gamma_0 h J)^-1 with the Jacobian at the step's start, J's modes
  * eliminated as in the stages: the errors of x1, v, x2 and of the memory's
- * force sum a phi, over the tolerance's scales (error_scale). */
+ * force sum a phi, to be set against error_length and error_speed. */
 typedef struct {
     double x1, v, x2, memory;
 } radau_errors;
@@ -300,7 +315,7 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
     /* sum a d_0 r_phi with r_phi = w (z_n - b phi) + e . (Phi - phi) */
     rho = w * z_n * s->q[0].re - s->relaxed - RADAU_E_SUM * s->p[0].re;
     for (l = 0; l < BLOCKS; l++) {
-        const complex_pair e_l = {radau_e_t[l == 0 ? 0 : 2 * l - 1], l == 0 ? 0.0 : radau_e_t[2 * l]};
+        const complex_pair e_l = coordinate_weight(radau_e_t, l);
         const complex_pair pp = l == 0 ? (complex_pair){s->pp0, 0.0} : with_d0(l, s->p[0].re, s->p[l]);
         const complex_pair qq = l == 0 ? (complex_pair){s->qq0, 0.0} : with_d0(l, s->q[0].re, s->q[l]);
         complex_pair sum = times(W[l], qq);
@@ -332,7 +347,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     int i, k, l;
     memory_sums_of(&cm->modes, h, &s);
     for (l = 0; l < BLOCKS; l++) {
-        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+        const complex_pair hl = h_lambda(h, l);
         complex_pair den = times(hl, s.q[l]), hl_ell;
         den.re += eta;
         ell[l] = reciprocal(den);
@@ -356,7 +371,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     }
     to_blocks(F, Ft);
     for (l = 0; l < BLOCKS; l++) {
-        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
+        const complex_pair hl = h_lambda(h, l);
         complex_pair force = {Ft[l].re / c_alpha - s.p[l].re, Ft[l].im / c_alpha - s.p[l].im};
         Zt[l] = times(ell[l], force);
         W[l] = times(hl, Zt[l]);
@@ -401,11 +416,8 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     Z[STAGES - 1] = trial->x2_rate;
     to_blocks(Z, Zt);
     for (l = 0; l < BLOCKS; l++) { /* the last row's weights on each coordinate, and on h lambda Z~ */
-        const complex_pair hl = {h * radau_lambda[l][0], h * radau_lambda[l][1]};
-        const complex_pair last = {radau_t[STAGES - 1][l == 0 ? 0 : 2 * l - 1],
-                                   l == 0 ? 0.0 : radau_t[STAGES - 1][2 * l]};
-        tau[l] = last;
-        tau_W[l] = times(last, times(hl, Zt[l]));
+        tau[l] = coordinate_weight(radau_t[STAGES - 1], l);
+        tau_W[l] = times(tau[l], times(h_lambda(h, l), Zt[l]));
     }
     for (j = 0; j < m->modes; j++) {
         const double x = h * m->b[j], phi = m->phi[j];
