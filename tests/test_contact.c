@@ -4,6 +4,7 @@
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "check.h"
 #include "contact.h"
@@ -472,6 +473,54 @@ static void test_radau_modes_are_the_last_stage(void)
     }
 }
 
+/* radau_iia.c built for the narrowest vectors (CMakeLists.txt). */
+double radau_step_narrow(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+void radau_advance_modes_narrow(contact_model *cm, const contact_state *trial);
+
+/* The springpot's passes over its modes run in the CPU's widest vectors,
+ * chosen at run time, yet sum in fixed lanes: a step and the modes'
+ * advance give the same bits as the narrowest build's, at every step of a
+ * springpot's impact (here with this CPU's widest: AVX-512, AVX or SSE2), so
+ * that a sweep's results do not depend on the machine that ran them. */
+static void test_radau_same_bits_at_every_vector_width(void)
+{
+    static const double alphas[] = {0.2, 0.5, 0.9};
+    size_t i;
+    for (i = 0; i < sizeof alphas / sizeof alphas[0]; i++) {
+        contact_params p;
+        contact_model cm, wide, narrow;
+        double v0, m;
+        int steps = 0, differ = 0;
+        contact_default_params(&p);
+        contact_default_striker(&v0, &m);
+        p.law = CONTACT_LAW_HERTZ;
+        p.damper = CONTACT_DAMPER_SPRINGPOT;
+        p.damper_order = alphas[i];
+        p.tolerance = 1e-8;
+        contact_start(&cm, &p, v0, m);
+        contact_advance_until(&cm, 1.0, CONTACT_ONSET);
+        while (cm.s.in_contact && steps < 1000) {
+            const double K = spring_stiffness(&cm, cm.s.n + 1), h = cm.s.n == 0 ? onset_step(&cm) : cm.s.h_next;
+            contact_state wide_trial, narrow_trial;
+            double J_wide, J_narrow;
+            memset(&wide_trial, 0, sizeof wide_trial);
+            memset(&narrow_trial, 0, sizeof narrow_trial);
+            J_wide = radau_step(&cm, &cm.s, h, K, &wide_trial);
+            J_narrow = radau_step_narrow(&cm, &cm.s, h, K, &narrow_trial);
+            differ += memcmp(&wide_trial, &narrow_trial, sizeof wide_trial) != 0 || J_wide != J_narrow;
+            contact_copy(&wide, &cm);
+            contact_copy(&narrow, &cm);
+            radau_advance_modes(&wide, &wide_trial);
+            radau_advance_modes_narrow(&narrow, &wide_trial);
+            differ += memcmp(wide.modes.phi, narrow.modes.phi, cm.modes.modes * sizeof cm.modes.phi[0]) != 0;
+            contact_advance(&cm, h); /* on along the impact */
+            steps++;
+        }
+        CHECK(steps > 10 && differ == 0, "alpha %g: %d of %d steps differ from the narrowest build's", alphas[i],
+              differ, steps);
+    }
+}
+
 int main(void)
 {
     test_hertz_constant();
@@ -485,6 +534,7 @@ int main(void)
     test_step_limit();
     test_springpot_onset_step();
     test_radau_modes_are_the_last_stage();
+    test_radau_same_bits_at_every_vector_width();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

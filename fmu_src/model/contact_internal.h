@@ -90,6 +90,11 @@ static inline double spring_force(const contact_model *cm, double K, double x1)
     return n == 1.5 ? K * x1 * sqrt(x1) : n == 1.0 ? K * x1 : K * pow(x1, n);
 }
 
+/* The springpot's passes over its modes sum in this many vector lanes
+ * (radau_iia.c), the modes padded to whole lanes by modes that add zeros:
+ * a divisor of CONTACT_MAX_MODES. */
+#define CONTACT_MODE_LANES 8
+
 /* contact_spring_stiffness, inline for the steps that take it every time. */
 static inline double spring_stiffness(const contact_model *cm, long n_steps)
 {

@@ -12,6 +12,15 @@
 /* Gamma(5/2) = 3 sqrt(pi) / 4: x1^(3/2) = Gamma(5/2) D^(-1/2) x1 (docs/model.md §3). */
 #define GAMMA_5_2 1.329340388179137
 
+/* Zero modes up to a whole number of the lanes the springpot's passes sum
+ * in: they add exact zeros. */
+static void pad_modes(contact_modes *m)
+{
+    size_t j;
+    for (j = m->modes; j % CONTACT_MODE_LANES != 0; j++)
+        m->a[j] = m->b[j] = m->phi[j] = 0.0;
+}
+
 void contact_configure(contact_model *cm, const contact_params *p)
 {
     const double n = p->spring_exponent;
@@ -35,6 +44,7 @@ void contact_configure(contact_model *cm, const contact_params *p)
         cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p),
                                      CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, cm->modes.a, cm->modes.b,
                                      &cm->modes.eta);
+    pad_modes(&cm->modes);
 }
 
 void contact_release(contact_model *cm)

@@ -4,8 +4,8 @@
  * stage order 2 (docs/numerics.md). The modes are linear, so they are
  * eliminated in the eigenbasis of the method's matrix A: per mode and
  * trial three reciprocals of 1 + h b lambda, and the stages' unknowns are
- * the five elastic indentations, solved together by Newton's method
- * (E. Hairer and G. Wanner, Solving Ordinary Differential Equations II,
+ * the five elastic indentations, solved together by the simplified Newton
+ * iteration in the same eigenbasis (E. Hairer and G. Wanner, Solving Ordinary Differential Equations II,
  * IV.5 and IV.8; Guglielmi and Hairer integrate fractional ODEs as such
  * stiff augmented systems with Radau IIA). */
 #include <float.h>
@@ -61,6 +61,25 @@ static const double radau_e[STAGES] = {-4.4189977167963814, 0.57923485225667004,
 static const double radau_e_t[STAGES] = {-2.9488838958995656, -2.1125062207358409, -4.1653916053844142,
                                          1.0847440059486784, -1.789163750822806};
 #define RADAU_E_SUM (-3.9766461106867279)
+
+/* The passes over the modes, compiled for the CPU's widest vectors and
+ * chosen at run time where GCC or Clang build for x86-64 (not for Windows,
+ * where GCC does not align the stack for 32-byte vectors). Every version
+ * gives the same bits (memory_sums_in_lanes, modes_to_last_stage). */
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(_WIN32) && !defined(CONTACT_NARROW_VECTORS)
+#define ALWAYS_INLINE __attribute__((always_inline))
+#define CPU_VERSIONS(name, params, args)                                        \
+    static void name##_sse2 params { name args; }                               \
+    __attribute__((target("avx"))) static void name##_avx params { name args; } \
+    __attribute__((target("avx512f"))) static void name##_avx512 params { name args; }
+#define CPU_VERSION(name, args)                                                                         \
+    (__builtin_cpu_supports("avx512f") ? name##_avx512 args : __builtin_cpu_supports("avx") ? name##_avx args \
+                                                                                          : name##_sse2 args)
+#else
+#define ALWAYS_INLINE
+#define CPU_VERSIONS(name, params, args)
+#define CPU_VERSION(name, args) name args
+#endif
 
 typedef struct {
     double re, im;
@@ -139,40 +158,68 @@ typedef struct {
     double pp0, qq0, relaxed;
 } memory_sums;
 
-static void memory_sums_of(const contact_modes *m, double h, memory_sums *s)
+/* The sums in CONTACT_MODE_LANES lanes: lane k sums the modes j = k mod
+ * lanes in their order, and the lanes are added in a fixed order after, so
+ * that a CPU's vector width changes no bit of them (C99 contracts no
+ * multiply-add). The modes are padded to whole lanes with a = b = phi = 0,
+ * which add exact zeros. */
+enum { SUM_P0, SUM_Q0, SUM_PP0, SUM_QQ0, SUM_RELAXED, SUM_P1R, SUM_P1I, SUM_Q1R, SUM_Q1I, SUM_P2R, SUM_P2I,
+       SUM_Q2R, SUM_Q2I, SUMS };
+
+static inline ALWAYS_INLINE void memory_sums_in_lanes(const contact_modes *m, double h,
+                                                       double lane[SUMS][CONTACT_MODE_LANES])
 {
     const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
-    double p0 = 0.0, q0 = 0.0, pp0 = 0.0, qq0 = 0.0, relaxed = 0.0;
-    double p1r = 0.0, p1i = 0.0, q1r = 0.0, q1i = 0.0, p2r = 0.0, p2i = 0.0, q2r = 0.0, q2i = 0.0;
     size_t j;
-#pragma omp simd reduction(+ : p0, q0, pp0, qq0, relaxed, p1r, p1i, q1r, q1i, p2r, p2i, q2r, q2i)
-    for (j = 0; j < m->modes; j++) {
-        const double x = h * m->b[j], a = m->a[j], ap = a * m->phi[j];
-        const double D0 = 1.0 + x * l0;
-        const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
-        const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
-        const double inv = 1.0 / (D0 * (N1 * N2));
-        const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
-        const double apd = ap * d0, ad = a * d0, ak1 = a * k1, apk1 = ap * k1, ak2 = a * k2, apk2 = ap * k2;
-        relaxed += apd * (x * l0);
-        p0 += apd;
-        q0 += ad;
-        pp0 += apd * d0;
-        qq0 += ad * d0;
-        p1r += apk1 * u1;
-        p1i -= apk1 * v1;
-        q1r += ak1 * u1;
-        q1i -= ak1 * v1;
-        p2r += apk2 * u2;
-        p2i -= apk2 * v2;
-        q2r += ak2 * u2;
-        q2i -= ak2 * v2;
+    int k, n;
+    for (n = 0; n < SUMS; n++)
+        for (k = 0; k < CONTACT_MODE_LANES; k++)
+            lane[n][k] = 0.0;
+    for (j = 0; j < m->modes; j += CONTACT_MODE_LANES) {
+#pragma omp simd
+        for (k = 0; k < CONTACT_MODE_LANES; k++) {
+            const double x = h * m->b[j + k], a = m->a[j + k], ap = a * m->phi[j + k];
+            const double D0 = 1.0 + x * l0;
+            const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
+            const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
+            const double inv = 1.0 / (D0 * (N1 * N2));
+            const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
+            const double apd = ap * d0, ad = a * d0, ak1 = a * k1, apk1 = ap * k1, ak2 = a * k2, apk2 = ap * k2;
+            lane[SUM_RELAXED][k] += apd * (x * l0);
+            lane[SUM_P0][k] += apd;
+            lane[SUM_Q0][k] += ad;
+            lane[SUM_PP0][k] += apd * d0;
+            lane[SUM_QQ0][k] += ad * d0;
+            lane[SUM_P1R][k] += apk1 * u1;
+            lane[SUM_P1I][k] -= apk1 * v1;
+            lane[SUM_Q1R][k] += ak1 * u1;
+            lane[SUM_Q1I][k] -= ak1 * v1;
+            lane[SUM_P2R][k] += apk2 * u2;
+            lane[SUM_P2I][k] -= apk2 * v2;
+            lane[SUM_Q2R][k] += ak2 * u2;
+            lane[SUM_Q2I][k] -= ak2 * v2;
+        }
     }
-    s->p[0].re = p0, s->p[0].im = 0.0, s->q[0].re = q0, s->q[0].im = 0.0;
-    s->p[1].re = p1r, s->p[1].im = p1i, s->q[1].re = q1r, s->q[1].im = q1i;
-    s->p[2].re = p2r, s->p[2].im = p2i, s->q[2].re = q2r, s->q[2].im = q2i;
-    s->pp0 = pp0, s->qq0 = qq0, s->relaxed = relaxed;
+}
+
+CPU_VERSIONS(memory_sums_in_lanes, (const contact_modes *m, double h, double lane[SUMS][CONTACT_MODE_LANES]),
+             (m, h, lane))
+
+static void memory_sums_of(const contact_modes *m, double h, memory_sums *s)
+{
+    double lane[SUMS][CONTACT_MODE_LANES], sum[SUMS];
+    int k, n;
+    CPU_VERSION(memory_sums_in_lanes, (m, h, lane));
+    for (n = 0; n < SUMS; n++) {
+        sum[n] = lane[n][0];
+        for (k = 1; k < CONTACT_MODE_LANES; k++)
+            sum[n] += lane[n][k];
+    }
+    s->p[0].re = sum[SUM_P0], s->p[0].im = 0.0, s->q[0].re = sum[SUM_Q0], s->q[0].im = 0.0;
+    s->p[1].re = sum[SUM_P1R], s->p[1].im = sum[SUM_P1I], s->q[1].re = sum[SUM_Q1R], s->q[1].im = sum[SUM_Q1I];
+    s->p[2].re = sum[SUM_P2R], s->p[2].im = sum[SUM_P2I], s->q[2].re = sum[SUM_Q2R], s->q[2].im = sum[SUM_Q2I];
+    s->pp0 = sum[SUM_PP0], s->qq0 = sum[SUM_QQ0], s->relaxed = sum[SUM_RELAXED];
 }
 
 /* sum a d_0 d_l y for l > 0 from the sums of a d_0 y and a d_l y. */
@@ -184,39 +231,6 @@ static complex_pair with_d0(int l, double sum0, complex_pair sum_l)
     num.re = radau_lambda[0][0] * sum0 - num.re;
     num.im = -num.im;
     return times(num, reciprocal(difference));
-}
-
-/* x := M^-1 x for a 5 x 5 M, Gaussian elimination with partial pivoting
- * (M is overwritten). */
-static void solve(double M[STAGES][STAGES], double x[STAGES])
-{
-    double inverse_pivot[STAGES];
-    int i, j, k;
-    for (k = 0; k < STAGES; k++) {
-        int p = k;
-        for (i = k + 1; i < STAGES; i++)
-            if (fabs(M[i][k]) > fabs(M[p][k]))
-                p = i;
-        if (p != k) {
-            double t;
-            for (j = k; j < STAGES; j++)
-                t = M[k][j], M[k][j] = M[p][j], M[p][j] = t;
-            t = x[k], x[k] = x[p], x[p] = t;
-        }
-        inverse_pivot[k] = 1.0 / M[k][k];
-        for (i = k + 1; i < STAGES; i++) {
-            const double f = M[i][k] * inverse_pivot[k];
-            for (j = k + 1; j < STAGES; j++)
-                M[i][j] -= f * M[k][j];
-            x[i] -= f * x[k];
-        }
-    }
-    for (k = STAGES - 1; k >= 0; k--) {
-        double s = x[k];
-        for (j = k + 1; j < STAGES; j++)
-            s -= M[k][j] * x[j];
-        x[k] = s * inverse_pivot[k];
-    }
 }
 
 /* The spring's force at an elastic indentation, and its slope there,
@@ -233,60 +247,66 @@ static inline double force_and_slope(const contact_model *cm, double K, double X
     return F;
 }
 
-/* A Newton iteration that changed no indentation by more than this part of
- * the largest leaves them exact to rounding (its error about the square of
- * the last correction); a trial that needs more than NEWTON_LIMIT is
- * rejected, and the step shrinks. */
-#define NEWTON_SETTLED 1e-8
+/* The simplified Newton iteration contracts by a factor theta each time,
+ * so that after a change d the indentations are within theta / (1 - theta)
+ * d of the root: it stops when that is below NEWTON_SETTLED of the largest
+ * indentation (far inside any tolerance), and a trial whose iteration grows
+ * or needs more than NEWTON_LIMIT is rejected, and the step shrinks. */
+#define NEWTON_SETTLED 1e-12
 #define NEWTON_LIMIT 30
 
 /* The stages' elastic indentations X from X + G F(X) = r, G = T diag(mu)
- * T^-1: Newton's method from the start's motion. 0 when it did not
- * converge. */
+ * T^-1, from the start's motion: Newton's method with the Jacobian
+ * I + G diag(F'(X)) taken as I + sigma G, sigma the mean slope of F at the
+ * first guess, which A's eigenbasis inverts as 1 / (1 + sigma mu_l),
+ * coordinate by coordinate: no linear system. Where the slopes differ
+ * little across the step, as everywhere but at an onset, it converges
+ * nearly as fast as Newton's method. 0 when it did not converge. */
 static int stage_indentations(const contact_model *cm, double K, const complex_pair mu[BLOCKS],
                               const double r[STAGES], double X[STAGES], double F[STAGES])
 {
-    double G[STAGES][STAGES];
-    int i, k, it;
+    complex_pair rho[BLOCKS], xi[BLOCKS], inverse[BLOCKS];
+    double slope, sigma = 0.0, previous = INFINITY;
+    int i, l, it;
     for (i = 0; i < STAGES; i++) {
-        double Tm[STAGES]; /* row i of T diag(mu) in the coordinates */
-        int l;
-        Tm[0] = radau_t[i][0] * mu[0].re;
-        for (l = 1; l < BLOCKS; l++) {
-            const double tr = radau_t[i][2 * l - 1], ti = radau_t[i][2 * l];
-            Tm[2 * l - 1] = tr * mu[l].re - ti * mu[l].im;
-            Tm[2 * l] = tr * mu[l].im + ti * mu[l].re;
-        }
-        for (k = 0; k < STAGES; k++) {
-            double g = 0.0;
-            int c;
-            for (c = 0; c < STAGES; c++)
-                g += Tm[c] * radau_t_inverse[c][k];
-            G[i][k] = g;
-        }
+        force_and_slope(cm, K, X[i], &slope);
+        sigma += slope;
     }
+    sigma *= 1.0 / STAGES;
+    for (l = 0; l < BLOCKS; l++) {
+        const complex_pair jacobian = {1.0 + sigma * mu[l].re, sigma * mu[l].im};
+        inverse[l] = reciprocal(jacobian);
+    }
+    to_blocks(r, rho);
+    to_blocks(X, xi);
     for (it = 0; it < NEWTON_LIMIT; it++) {
-        double J[STAGES][STAGES], R[STAGES], slope[STAGES], change = 0.0, scale = DBL_MIN;
+        complex_pair Ft[BLOCKS];
+        double change = 0.0, scale = DBL_MIN, theta;
         for (i = 0; i < STAGES; i++)
-            F[i] = force_and_slope(cm, K, X[i], &slope[i]);
-        for (i = 0; i < STAGES; i++) {
-            R[i] = r[i] - X[i];
-            for (k = 0; k < STAGES; k++) {
-                R[i] -= G[i][k] * F[k];
-                J[i][k] = G[i][k] * slope[k] + (i == k);
-            }
+            F[i] = spring_force(cm, K, larger(X[i], 0.0));
+        to_blocks(F, Ft);
+        for (l = 0; l < BLOCKS; l++) {
+            const complex_pair muF = times(mu[l], Ft[l]);
+            const complex_pair residual = {rho[l].re - xi[l].re - muF.re, rho[l].im - xi[l].im - muF.im};
+            const complex_pair step = times(residual, inverse[l]);
+            xi[l].re += step.re;
+            xi[l].im += step.im;
         }
-        solve(J, R);
         for (i = 0; i < STAGES; i++) {
-            X[i] += R[i];
-            change = larger(change, fabs(R[i]));
-            scale = larger(scale, fabs(X[i]));
+            const double next = from_blocks_at(xi, i);
+            change = larger(change, fabs(next - X[i]));
+            scale = larger(scale, fabs(next));
+            X[i] = next;
         }
-        if (!(change > NEWTON_SETTLED * scale)) {
+        theta = change / previous; /* 0 at the first iteration, which cannot stop */
+        if (!(theta < 1.0))
+            return 0;
+        if (it > 0 && !(theta / (1.0 - theta) * change > NEWTON_SETTLED * scale)) {
             for (i = 0; i < STAGES; i++)
-                F[i] = force_and_slope(cm, K, X[i], &slope[i]);
+                F[i] = spring_force(cm, K, larger(X[i], 0.0));
             return 1;
         }
+        previous = change;
     }
     return 0;
 }
@@ -400,6 +420,34 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     return impulse;
 }
 
+/* Each mode to the last stage's value, elementwise: any vector width gives
+ * the same bits. */
+static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, double h, const complex_pair tau[BLOCKS],
+                                                      const complex_pair tau_W[BLOCKS])
+{
+    const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
+    const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
+    const double t0 = tau[0].re, t1r = tau[1].re, t1i = tau[1].im, t2r = tau[2].re, t2i = tau[2].im;
+    const double w0 = tau_W[0].re, w1r = tau_W[1].re, w1i = tau_W[1].im, w2r = tau_W[2].re, w2i = tau_W[2].im;
+    size_t j;
+#pragma omp simd
+    for (j = 0; j < m->modes; j++) {
+        const double x = h * m->b[j], phi = m->phi[j];
+        const double D0 = 1.0 + x * l0;
+        const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
+        const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
+        /* Re(tau (phi + W) / s) = Re(tau (phi + W) conj(s)) / |s|^2 for s = 1 + x lambda */
+        const double n0 = phi * t0 + w0;
+        const double n1 = (phi * t1r + w1r) * u1 + (phi * t1i + w1i) * v1;
+        const double n2 = (phi * t2r + w2r) * u2 + (phi * t2i + w2i) * v2;
+        m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));
+    }
+}
+
+CPU_VERSIONS(modes_to_last_stage,
+             (contact_modes * m, double h, const complex_pair tau[BLOCKS], const complex_pair tau_W[BLOCKS]),
+             (m, h, tau, tau_W))
+
 /* The modes after an accepted step: the last stage's (stiffly accurate),
  * Phi = (I + h b A)^-1 (phi_n 1 + h A Z) in the coordinates, from the
  * trial's stage rates Z. */
@@ -409,7 +457,6 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     const double h = trial->step;
     double Z[STAGES];
     complex_pair Zt[BLOCKS], tau[BLOCKS], tau_W[BLOCKS];
-    size_t j;
     int l;
     Z[0] = trial->x2_rate1;
     memcpy(Z + 1, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
@@ -419,15 +466,5 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
         tau[l] = coordinate_weight(radau_t[STAGES - 1], l);
         tau_W[l] = times(tau[l], times(h_lambda(h, l), Zt[l]));
     }
-    for (j = 0; j < m->modes; j++) {
-        const double x = h * m->b[j], phi = m->phi[j];
-        const double D0 = 1.0 + x * radau_lambda[0][0];
-        const double u1 = 1.0 + x * radau_lambda[1][0], v1 = x * radau_lambda[1][1], N1 = u1 * u1 + v1 * v1;
-        const double u2 = 1.0 + x * radau_lambda[2][0], v2 = x * radau_lambda[2][1], N2 = u2 * u2 + v2 * v2;
-        /* Re(tau (phi + W) / s) = Re(tau (phi + W) conj(s)) / |s|^2 for s = 1 + x lambda */
-        const double n0 = phi * tau[0].re + tau_W[0].re;
-        const double n1 = (phi * tau[1].re + tau_W[1].re) * u1 + (phi * tau[1].im + tau_W[1].im) * v1;
-        const double n2 = (phi * tau[2].re + tau_W[2].re) * u2 + (phi * tau[2].im + tau_W[2].im) * v2;
-        m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));
-    }
+    CPU_VERSION(modes_to_last_stage, (m, h, tau, tau_W));
 }
