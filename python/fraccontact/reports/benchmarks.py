@@ -1115,6 +1115,16 @@ def as_accurate(error, ladder, reference):
     return None
 
 
+def widest_vectors():
+    """The widest vectors radau_iia.c picks on this machine's CPU, from the
+    flags Linux reports (its run-time choice reads the same CPUID bits)."""
+    try:
+        flags = next((line.split(":", 1)[1].split() for line in open("/proc/cpuinfo") if line.startswith("flags")), [])
+    except OSError:
+        flags = []
+    return "AVX-512" if "avx512f" in flags else "AVX" if "avx" in flags else "SSE2"
+
+
 def controlled_section(rows, ladder, reference, by_order, by_kernel, default_steps):
     out = [CONTROLLED_BEGIN, "## The springpot under error control", "",
            "Regenerate this section alone, in place: `scripts/report benchmarks --only controlled` (a few "
@@ -1149,7 +1159,9 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
             f"tolerances: **{'met' if met else 'not met'}** ({', '.join(f'{q:.1f}x' for q in ratios)}). "
             f"The springpot takes {span(counts['springpot'][0] / counts['dashpot'][0], counts['springpot'][-1] / counts['dashpot'][-1])} "
             f"times the dashpot's steps, and each costs {span(*step_ratios)} "
-            "times a dashpot step: its five coupled stages and, per trial, a pass over its modes (docs/numerics.md). "
+            "times a dashpot step: its five coupled stages (the simplified Newton iteration in A's eigenbasis) "
+            f"and, per trial, a pass over its modes in the CPU's widest vectors (here {widest_vectors()}; the "
+            "same bits at every width: docs/model.md §12). "
             "From the first tolerance to the second the error falls like the steps to the "
             f"power {order['dashpot']:.1f} for the dashpot and {order['springpot']:.1f} for the springpot, whose "
             "embedded estimate (order 5) is far more cautious than its solution (order 9): at the same tolerance "
