@@ -130,13 +130,15 @@ static void indentation_cubic(const contact_model *cm, const contact_state *s, c
 
 /* Where in (0, 1) the polynomial p[0] + p[1] theta + ... + p[degree]
  * theta^degree falls from > 0 at 0 to <= 0 at 1: Newton's method kept
- * inside the shrinking bracket, bisecting where it leaves it. */
+ * inside the shrinking bracket, bisecting where it leaves it, until a
+ * Newton step or the bracket is below 1e-12 (a Newton step that small
+ * leaves the iterate exact to rounding). */
 static double polynomial_root(const double *p, int degree)
 {
     double lo = 0.0, hi = 1.0, theta = 0.5;
     int i, j;
     for (i = 0; i < 60 && hi - lo > 1e-12; i++) {
-        double value = p[degree], slope = 0.0;
+        double value = p[degree], slope = 0.0, next;
         for (j = degree - 1; j >= 0; j--) {
             slope = slope * theta + value;
             value = value * theta + p[j];
@@ -145,9 +147,10 @@ static double polynomial_root(const double *p, int degree)
             lo = theta;
         else
             hi = theta;
-        theta = slope < 0.0 ? theta - value / slope : -1.0;
-        if (!(theta > lo && theta < hi))
-            theta = 0.5 * (lo + hi);
+        next = slope < 0.0 ? theta - value / slope : -1.0;
+        if (fabs(next - theta) <= 1e-12)
+            return smaller(larger(next, lo), hi);
+        theta = next > lo && next < hi ? next : 0.5 * (lo + hi);
     }
     return theta;
 }

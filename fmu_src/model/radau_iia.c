@@ -281,7 +281,7 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
     to_blocks(X, xi);
     for (it = 0; it < NEWTON_LIMIT; it++) {
         complex_pair Ft[BLOCKS];
-        double change = 0.0, scale = DBL_MIN, theta;
+        double change = 0.0, scale = DBL_MIN;
         for (i = 0; i < STAGES; i++)
             F[i] = spring_force(cm, K, larger(X[i], 0.0));
         to_blocks(F, Ft);
@@ -298,10 +298,12 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
             scale = larger(scale, fabs(next));
             X[i] = next;
         }
-        theta = change / previous; /* 0 at the first iteration, which cannot stop */
-        if (!(theta < 1.0))
+        /* theta = change / previous, and theta / (1 - theta) change below
+         * the bound, without a division on the iteration's path; the first
+         * iteration (previous infinite) cannot stop */
+        if (!(change < previous))
             return 0;
-        if (it > 0 && !(theta / (1.0 - theta) * change > NEWTON_SETTLED * scale)) {
+        if (it > 0 && !(change * change > NEWTON_SETTLED * scale * (previous - change))) {
             for (i = 0; i < STAGES; i++)
                 F[i] = spring_force(cm, K, larger(X[i], 0.0));
             return 1;

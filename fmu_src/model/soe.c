@@ -44,8 +44,10 @@ static void fast_tail(double alpha, double lg_alpha, double x, double *value, do
 }
 
 /* The smallest x in [lo, hi] with f(x) <= target for a decreasing f: lo if
- * f(lo) is already below, hi if f(hi) is not. Newton's method in ln x,
- * kept inside the bracket (a step leaving it bisects it), to rounding. */
+ * f(lo) is already below, hi if f(hi) is not. Newton's method on ln f as a
+ * function of x, in which both bounds are nearly straight lines (a few
+ * steps from hi, where in ln x they are exponentials), kept inside the
+ * bracket in ln x (a step leaving it bisects it), to rounding. */
 static double decreasing_below(log_bound f, double alpha, double target, double lo, double hi)
 {
     const double lg_alpha = lgamma(alpha), goal = log(target);
@@ -59,7 +61,10 @@ static double decreasing_below(log_bound f, double alpha, double target, double 
         return hi;
     s = b;
     for (i = 0; i < 100; i++) {
-        double next = s - (value - goal) / slope;
+        /* x (1 - (ln f - goal) / (d ln f / d ln x)), in ln x; a step
+         * to x <= 0 lands on the bracket's end and bisects it */
+        const double ratio = 1.0 - (value - goal) / slope;
+        double next = ratio > 0.0 ? s + log(ratio) : a;
         /* quadratic convergence: after a step of 1e-13 the iterate is
          * exact to rounding (an absolute step in ln x, which is >= 0) */
         if (fabs(next - s) <= 1e-13)
