@@ -9,6 +9,7 @@
 #include "check.h"
 #include "contact.h"
 #include "contact_internal.h"
+#include "soe.h"
 
 static const double V0 = 0.626418, M = 0.7437; /* the paper's h20 drop */
 
@@ -473,6 +474,26 @@ static void test_radau_modes_are_the_last_stage(void)
     }
 }
 
+/* contact_check_params counts a springpot's modes only below
+ * CONTACT_MEMORY_FLOOR: at the floor every alpha and memory_tolerance fits
+ * CONTACT_MAX_MODES (and a higher floor needs fewer). Checked here over
+ * alpha from 0.0005 to 0.9995 and memory_tolerance from 1e-2 to 1e-12,
+ * 12 a decade. */
+static void test_kernels_above_the_floor_fit(void)
+{
+    double a[CONTACT_MAX_MODES + 1], b[CONTACT_MAX_MODES + 1], eta;
+    size_t most = 0;
+    int i, j;
+    for (i = 0; i < 1000; i++)
+        for (j = 0; j <= 120; j++) {
+            const double alpha = (i + 0.5) / 1000.0, tolerance = 1e-2 * pow(10.0, -j / 12.0);
+            const size_t n = soe_kernel(alpha, tolerance, CONTACT_MEMORY_FLOOR, CONTACT_MEMORY_SPAN,
+                                        CONTACT_MAX_MODES, a, b, &eta);
+            most = n > most ? n : most;
+        }
+    CHECK(most <= CONTACT_MAX_MODES, "at the floor a kernel needs up to %zu modes", most);
+}
+
 /* radau_iia.c built for the narrowest vectors (CMakeLists.txt). */
 double radau_step_narrow(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void radau_advance_modes_narrow(contact_model *cm, const contact_state *trial);
@@ -535,6 +556,7 @@ int main(void)
     test_springpot_onset_step();
     test_radau_modes_are_the_last_stage();
     test_radau_same_bits_at_every_vector_width();
+    test_kernels_above_the_floor_fit();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

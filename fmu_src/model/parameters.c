@@ -144,7 +144,12 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
     if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->scheme == CONTACT_SCHEME_CENTRAL)
         return contact_reject(msg, len, "scheme", p->scheme,
                               "the central differences (2) drive the dashpot only; the springpot (damper = 2) needs 1");
-    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_COMPRESSED) {
+    /* A kernel floor at or above CONTACT_MEMORY_FLOOR fits CONTACT_MAX_MODES
+     * at every alpha and memory_tolerance, as the floor was chosen (tests:
+     * test_contact's test_kernels_above_the_floor_fit): only a smaller dt_max
+     * needs its kernel built to count the modes. */
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_COMPRESSED
+        && memory_kernel_floor(p) < CONTACT_MEMORY_FLOOR) {
         double a[CONTACT_MAX_MODES], b[CONTACT_MAX_MODES], eta;
         if (soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p), CONTACT_MEMORY_SPAN,
                        CONTACT_MAX_MODES, a, b, &eta) > CONTACT_MAX_MODES)
