@@ -515,7 +515,7 @@ static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 /* The run behind fc_run and fc_run_batch: out may be NULL (no rows), and
  * impacts NULL (only the first is kept, in r->outcome.first). */
 static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts, watch *w,
-                     fc_outcome *o, char *msg, size_t len)
+                     contact_kernel *kernel, fc_outcome *o, char *msg, size_t len)
 {
     contact_params q;
     contact_model cm, snapshot;
@@ -528,7 +528,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
     dt = contact_step_limit(&q);
-    contact_start(&cm, &q, p->v, p->m);
+    contact_start_with(&cm, &q, p->v, p->m, kernel);
     watch_run(w, &cm);
     uniform = contact_steps_uniformly(&q);
     grid = rows_on_grid(&q);
@@ -594,7 +594,7 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
     fc_status status;
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
-    status = run(p, interval, interval == FC_NO_ROWS ? NULL : &rows, &impacts, &w, &r->outcome, msg, len);
+    status = run(p, interval, interval == FC_NO_ROWS ? NULL : &rows, &impacts, &w, NULL, &r->outcome, msg, len);
     if (rows.failed) { /* no half of a time series */
         free(rows.rows);
         rows.rows = NULL;
@@ -640,10 +640,12 @@ fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outco
     batch_watch b = {progress, ctx, 0, n};
     watch w = {progress ? batch_progress : NULL, &b, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0};
     fc_status first = FC_OK, status = FC_OK;
+    contact_kernel kernel; /* runs alike share their springpot's kernel */
     size_t i;
+    kernel.floor = 0.0;
     for (i = 0; i < n && status != FC_ESTOPPED; i++) {
         b.done = i;
-        status = run(&params[i], FC_NO_ROWS, NULL, NULL, &w, &out[i], why, sizeof why);
+        status = run(&params[i], FC_NO_ROWS, NULL, NULL, &w, &kernel, &out[i], why, sizeof why);
         if (first == FC_OK)
             first = status;
         if (status != FC_ESTOPPED && progress && progress(ctx, i + 1, n) != 0 && i + 1 < n)

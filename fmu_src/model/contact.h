@@ -315,6 +315,20 @@ void contact_configure(contact_model *cm, const contact_params *p);
  * model is overwritten: release one that holds a G1 history first. */
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m);
 
+/* A compressed memory's kernel and what it was built for (soe.h), kept by a
+ * caller that starts many models alike, as a batch of runs does: building
+ * it costs more than a dashpot's whole impact. */
+typedef struct {
+    double damper_order, memory_tolerance, floor; /* floor 0: none yet */
+    size_t modes;
+    double eta, a[CONTACT_MAX_MODES], b[CONTACT_MAX_MODES];
+} contact_kernel;
+
+/* contact_start, taking the kernel from *kernel when it was built for the
+ * same damper_order, memory_tolerance and kernel floor (the same bits as
+ * building it), and keeping the one it builds there otherwise. */
+void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel);
+
 /* Frees the G1 history's buffer (the only memory a model allocates, when a
  * springpot with memory = 1 steps); the model may start again. A struct copy
  * of such a model shares the buffer: never advance both. */

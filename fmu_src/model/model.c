@@ -17,11 +17,41 @@
 static void pad_modes(contact_modes *m)
 {
     size_t j;
-    for (j = m->modes; j % CONTACT_MODE_LANES != 0; j++)
+    for (j = m->modes; j % CONTACT_MODE_LANES != 0 && j < CONTACT_MAX_MODES; j++)
         m->a[j] = m->b[j] = m->phi[j] = 0.0;
 }
 
-void contact_configure(contact_model *cm, const contact_params *p)
+static int kernel_fits(const contact_kernel *k, const contact_params *p)
+{
+    return k->floor == memory_kernel_floor(p) && k->damper_order == p->damper_order
+           && k->memory_tolerance == p->memory_tolerance;
+}
+
+/* The compressed memory's kernel (docs/model.md §6), from *kept when it
+ * fits p, and kept there otherwise (kept may be NULL). */
+static void memory_kernel(contact_modes *m, const contact_params *p, contact_kernel *kept)
+{
+    if (kept && kernel_fits(kept, p) && kept->modes <= CONTACT_MAX_MODES) {
+        m->modes = kept->modes;
+        m->eta = kept->eta;
+        memcpy(m->a, kept->a, kept->modes * sizeof m->a[0]);
+        memcpy(m->b, kept->b, kept->modes * sizeof m->b[0]);
+        return;
+    }
+    m->modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p), CONTACT_MEMORY_SPAN,
+                          CONTACT_MAX_MODES, m->a, m->b, &m->eta);
+    if (kept && m->modes <= CONTACT_MAX_MODES) {
+        kept->damper_order = p->damper_order;
+        kept->memory_tolerance = p->memory_tolerance;
+        kept->floor = memory_kernel_floor(p);
+        kept->modes = m->modes;
+        kept->eta = m->eta;
+        memcpy(kept->a, m->a, m->modes * sizeof m->a[0]);
+        memcpy(kept->b, m->b, m->modes * sizeof m->b[0]);
+    }
+}
+
+static void configure(contact_model *cm, const contact_params *p, contact_kernel *kept)
 {
     const double n = p->spring_exponent;
     cm->p = *p;
@@ -41,10 +71,13 @@ void contact_configure(contact_model *cm, const contact_params *p)
     cm->modes.modes = 0;
     cm->modes.h = 0.0;
     if (compressed_memory(cm))
-        cm->modes.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p),
-                                     CONTACT_MEMORY_SPAN, CONTACT_MAX_MODES, cm->modes.a, cm->modes.b,
-                                     &cm->modes.eta);
+        memory_kernel(&cm->modes, p, kept);
     pad_modes(&cm->modes);
+}
+
+void contact_configure(contact_model *cm, const contact_params *p)
+{
+    configure(cm, p, NULL);
 }
 
 void contact_release(contact_model *cm)
@@ -56,8 +89,13 @@ void contact_release(contact_model *cm)
 
 void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
 {
+    contact_start_with(cm, p, v0, m, NULL);
+}
+
+void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
+{
     memset(cm, 0, sizeof *cm);
-    contact_configure(cm, p);
+    configure(cm, p, kernel);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {

@@ -249,11 +249,11 @@ static inline double force_and_slope(const contact_model *cm, double K, double X
 
 /* The simplified Newton iteration contracts by a factor theta each time,
  * so that after a change d the indentations are within theta / (1 - theta)
- * d of the root: it stops when that is below a hundredth of the tolerance
- * of the largest indentation, and at most NEWTON_SETTLED of it (far inside
- * the step's error), and a trial whose iteration grows or needs more than
- * NEWTON_LIMIT is rejected, and the step shrinks. */
-#define NEWTON_SETTLED 1e-10
+ * d of the root: it stops when that is below NEWTON_SETTLED times the
+ * tolerance of the largest indentation, far inside the step's error (Hairer
+ * and Wanner's kappa Tol, IV.8), and a trial whose iteration grows or needs
+ * more than NEWTON_LIMIT is rejected, and the step shrinks. */
+#define NEWTON_SETTLED 1e-2
 #define NEWTON_LIMIT 30
 
 /* The stages' elastic indentations X from X + G F(X) = r, G = T diag(mu)
@@ -267,7 +267,7 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
                               const double r[STAGES], double X[STAGES], double F[STAGES])
 {
     complex_pair rho[BLOCKS], xi[BLOCKS], inverse[BLOCKS];
-    const double settled = smaller(NEWTON_SETTLED, 1e-2 * cm->p.tolerance);
+    const double settled = NEWTON_SETTLED * cm->p.tolerance;
     double slope, sigma = 0.0, previous = INFINITY;
     int i, l, it;
     for (i = 0; i < STAGES; i++) {
