@@ -132,9 +132,10 @@ typedef struct {
      * the damper's rate x2' at its stages (the last is the end's), and an
      * error-controlled step's error over the tolerance: SDIRK2's two
      * stages in x2_rate1 and x2_rate, a springpot's Radau IIA step's five
-     * in x2_rate1, x2_rate_inner and x2_rate. */
+     * in x2_rate1, x2_rate_inner and x2_rate, and its elastic indentations
+     * at the first four stages (x1 is the fifth's) for its dense output. */
     double step, x2_rate1, x2_rate, error;
-    double x2_rate_inner[3];
+    double x2_rate_inner[3], x1_inner[4];
 } contact_state;
 
 /* Every field of contact_state carried from step to step, described once: DOUBLE(name) for the doubles,

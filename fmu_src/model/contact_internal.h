@@ -31,6 +31,7 @@ void advance_modes(contact_model *cm, double h, double z1, double z2);
 double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void radau_advance_modes(contact_model *cm, const contact_state *trial);
+void radau_indentation_polynomial(const contact_state *s, const contact_state *trial, double p[6]);
 
 /* control.c */
 double next_step(double h, double error, double least);
@@ -118,6 +119,13 @@ static inline int controlled_steps(const contact_model *cm, const contact_state 
     return cm->error_controlled && s->in_contact;
 }
 
+/* Whether an error-controlled step from *s is Radau IIA's: the compressed
+ * springpot's in contact. */
+static inline int radau_steps(const contact_model *cm, const contact_state *s)
+{
+    return springpot(cm) && controlled_steps(cm, s);
+}
+
 /* An error-controlled step: the dashpot's ESDIRK, the compressed
  * springpot's Radau IIA in contact and SDIRK2 out of it. */
 static inline double controlled_step(contact_model *cm, const contact_state *in, double h, double K,
@@ -125,7 +133,7 @@ static inline double controlled_step(contact_model *cm, const contact_state *in,
 {
     if (!springpot(cm))
         return esdirk_step(cm, in, h, K, out);
-    if (!controlled_steps(cm, in))
+    if (!radau_steps(cm, in))
         return sdirk_step(cm, in, h, K, out);
     return radau_step(cm, in, h, K, out);
 }

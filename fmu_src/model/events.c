@@ -155,21 +155,50 @@ static double polynomial_root(const double *p, int degree)
     return theta;
 }
 
+/* x1 over an error-controlled step from *s to *end as a polynomial in
+ * theta = tau / h, p[0..degree]: Radau IIA's collocation polynomial (its
+ * dense output), or the cubic through the step's ends. Its degree. */
+static int indentation_polynomial(const contact_model *cm, const contact_state *s, const contact_state *end,
+                                  double h, double p[6])
+{
+    if (radau_steps(cm, s)) {
+        radau_indentation_polynomial(s, end, p);
+        return 5;
+    }
+    indentation_cubic(cm, s, end, h, p);
+    return 3;
+}
+
+/* Where in (0, 1) the polynomial p of this degree turns (its slope falls
+ * to 0). */
+static double polynomial_turn(const double *p, int degree)
+{
+    double slope[5];
+    int i;
+    for (i = 0; i < degree; i++)
+        slope[i] = (i + 1) * p[i + 1];
+    return polynomial_root(slope, degree - 1);
+}
+
+static double polynomial_at(const double *p, int degree, double theta)
+{
+    double value = p[degree];
+    int i;
+    for (i = degree - 1; i >= 0; i--)
+        value = value * theta + p[i];
+    return value;
+}
+
 /* The first trial of an event's search in an error-controlled step, as a
- * fraction of the step, from the cubic through its ends: where x1 falls to
- * 0 (separation) or where its slope does (the peak). Fixed steps locate
- * their events as they always have, without a guess. */
+ * fraction of the step, from x1's polynomial over it: where x1 falls to 0
+ * (separation) or where its slope does (the peak). Fixed steps locate their
+ * events as they always have, without a guess. */
 static double event_guess(const contact_model *cm, const contact_state *s, const contact_state *end, double h,
                           int peak)
 {
-    double p[4], slope[3];
-    indentation_cubic(cm, s, end, h, p);
-    if (!peak)
-        return polynomial_root(p, 3);
-    slope[0] = p[1];
-    slope[1] = 2.0 * p[2];
-    slope[2] = 3.0 * p[3];
-    return polynomial_root(slope, 2);
+    double p[6];
+    const int degree = indentation_polynomial(cm, s, end, h, p);
+    return peak ? polynomial_turn(p, degree) : polynomial_root(p, degree);
 }
 
 /* Where a fixed step from *s of length h, whose end *trial lies past the
@@ -226,7 +255,8 @@ double separation_within(contact_model *cm, const contact_state *s, double h, do
 /* The force where the indentation turns inside a contact step from *s to
  * *end: sampling the peak at step ends alone would err by O(h^2) of the
  * force's curvature, more than the scheme itself. With fixed steps the turn
- * is located to rounding; an error-controlled step takes the force one step
+ * is located to rounding. Radau IIA reads it off its dense output, whose x1
+ * errs by O(h^6) of the motion's scale. ESDIRK takes the force one step
  * from *s to where the cubic through the step's ends turns: that time is
  * off by O(h^4) of the motion's scale, and a force read delta from its peak
  * is low by O(delta^2), far below the tolerance. */
@@ -234,7 +264,11 @@ double force_at_turn(contact_model *cm, const contact_state *s, double h, double
 {
     contact_state at;
     double J;
-    if (error_controlled(cm))
+    if (radau_steps(cm, s)) {
+        double p[6];
+        const int degree = indentation_polynomial(cm, s, end, h, p);
+        at.F = spring_force(cm, K, larger(polynomial_at(p, degree, polynomial_turn(p, degree)), 0.0));
+    } else if (error_controlled(cm))
         contact_step(cm, s, event_guess(cm, s, end, h, 1) * h, K, &at);
     else
         event_time(cm, s, h, K, indentation_rate, indentation_rate(cm, end), 1e-15, -1.0, &at, &J);

@@ -418,6 +418,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     out->E_diss = in->E_diss + work;
     out->x2_rate1 = Z[0];
     memcpy(out->x2_rate_inner, Z + 1, sizeof out->x2_rate_inner);
+    memcpy(out->x1_inner, X, sizeof out->x1_inner);
     out->x2_rate = Z[STAGES - 1];
     error = larger(larger(fabs(e.x1), fabs(e.x2)), fabs(e.memory)) / error_length(cm, in, K, out);
     out->error = larger(error, fabs(e.v) / error_speed(in, out)) / cm->p.tolerance;
@@ -471,4 +472,33 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
         tau_W[l] = times(tau[l], times(h_lambda(h, l), Zt[l]));
     }
     CPU_VERSION(modes_to_last_stage, (m, h, tau, tau_W));
+}
+
+/* x1 over a trial from *s to *trial as a polynomial in theta = tau / h,
+ * p[0] + p[1] theta + ... + p[5] theta^5: the collocation polynomial
+ * through x1 at the step's start and at the five stages, Radau IIA's dense
+ * output (of the stage order 5), from its divided differences. */
+void radau_indentation_polynomial(const contact_state *s, const contact_state *trial, double p[STAGES + 1])
+{
+    double node[STAGES + 1], y[STAGES + 1];
+    int i, j;
+    node[0] = 0.0;
+    y[0] = s->x1;
+    for (i = 0; i < STAGES; i++) {
+        node[i + 1] = radau_c[i];
+        y[i + 1] = i < STAGES - 1 ? trial->x1_inner[i] : trial->x1;
+    }
+    for (j = 1; j <= STAGES; j++)
+        for (i = STAGES; i >= j; i--)
+            y[i] = (y[i] - y[i - 1]) / (node[i] - node[i - j]);
+    /* the Newton form y0 + y1 (theta - n0) + y2 (theta - n0)(theta - n1) + ...
+     * multiplied out from its innermost term */
+    for (i = 0; i <= STAGES; i++)
+        p[i] = 0.0;
+    p[0] = y[STAGES];
+    for (j = STAGES - 1; j >= 0; j--) {
+        for (i = STAGES - j; i > 0; i--)
+            p[i] = p[i - 1] - node[j] * p[i];
+        p[0] = y[j] - node[j] * p[0];
+    }
 }

@@ -158,10 +158,15 @@ MUTANTS = [
            (RADAU, "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));",
             "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N2)) / (D0 * (N1 * N2));")),
     mutant("radau-newton-settled", "time scheme", "Radau IIA: the stages' simplified Newton iteration stops "
-           "1e6 times early (1e-6 of the largest indentation left to the root, not 1e-12)",
-           "each stage's indentation off by up to 1e-6 of its scale; test_tolerance: the springpot's figures at "
-           "tolerance 1e-8 against the exact kernel",
-           (RADAU, "#define NEWTON_SETTLED 1e-12", "#define NEWTON_SETTLED 1e-6")),
+           "1e4 times early (100 tolerances of the largest indentation left to the root, not a hundredth)",
+           "each stage's indentation off by up to 100 tolerances of its scale; test_claims: the springpot table's "
+           "figures against the full G1 history",
+           (RADAU, "#define NEWTON_SETTLED 1e-2", "#define NEWTON_SETTLED 1e2")),
+    mutant("radau-dense-output", "events", "Radau IIA's dense output interpolates the step's end where its start "
+           "belongs",
+           STRUCTURAL + "; F_peak read off a wrong polynomial: test_claims, the springpot table's F_peak against the "
+           "full G1 history",
+           (RADAU, "    y[0] = s->x1;", "    y[0] = trial->x1;")),
     mutant("radau-estimate-memory", "time scheme", "Radau IIA: the error estimate's filter without the modes' own "
            "residuals",
            "the estimate changes, and with it the steps; test_claims::test_the_springpot_table_of_error_controlled_steps: "
