@@ -271,7 +271,7 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
     double slope, sigma = 0.0, previous = INFINITY;
     int i, l, it;
     for (i = 0; i < STAGES; i++) {
-        force_and_slope(cm, K, X[i], &slope);
+        F[i] = force_and_slope(cm, K, X[i], &slope);
         sigma += slope;
     }
     sigma *= 1.0 / STAGES;
@@ -281,11 +281,9 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
     }
     to_blocks(r, rho);
     to_blocks(X, xi);
-    for (it = 0; it < NEWTON_LIMIT; it++) {
+    for (it = 0; it < NEWTON_LIMIT; it++) { /* F is the spring's force at X */
         complex_pair Ft[BLOCKS];
         double change = 0.0, scale = DBL_MIN;
-        for (i = 0; i < STAGES; i++)
-            F[i] = spring_force(cm, K, larger(X[i], 0.0));
         to_blocks(F, Ft);
         for (l = 0; l < BLOCKS; l++) {
             const complex_pair muF = times(mu[l], Ft[l]);
@@ -299,17 +297,15 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
             change = larger(change, fabs(next - X[i]));
             scale = larger(scale, fabs(next));
             X[i] = next;
+            F[i] = spring_force(cm, K, larger(next, 0.0));
         }
         /* theta = change / previous, and theta / (1 - theta) change below
          * the bound, without a division on the iteration's path; the first
          * iteration (previous infinite) cannot stop */
         if (!(change < previous))
             return 0;
-        if (it > 0 && !(change * change > settled * scale * (previous - change))) {
-            for (i = 0; i < STAGES; i++)
-                F[i] = spring_force(cm, K, larger(X[i], 0.0));
+        if (it > 0 && !(change * change > settled * scale * (previous - change)))
             return 1;
-        }
         previous = change;
     }
     return 0;
@@ -327,7 +323,7 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
                                     const memory_sums *s, const double X[STAGES], const double V[STAGES],
                                     const double travel[STAGES], const complex_pair W[BLOCKS])
 {
-    const double w = radau_lambda[0][0] * h, c_alpha = cm->p.c_alpha, inv_m = cm->inv_m, z_n = in->x2_rate;
+    const double w = radau_lambda[0][0] * h, inv_c_alpha = 1.0 / cm->p.c_alpha, inv_m = cm->inv_m, z_n = in->x2_rate;
     double r_x1 = w * (in->v - z_n), r_v = w * (cm->accel - inv_m * in->F), r_x2 = w * z_n, rho, kk, slope, ex1, dz;
     radau_errors e;
     int i, l;
@@ -349,8 +345,8 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
     }
     kk = 1.0 / (cm->modes.eta + w * s->q[0].re);
     force_and_slope(cm, K, in->x1, &slope);
-    ex1 = (r_x1 + w * kk * rho + w * r_v) / (1.0 + w * kk * slope / c_alpha + w * w * slope * inv_m);
-    dz = kk * (slope * ex1 / c_alpha - rho);
+    ex1 = (r_x1 + w * kk * rho + w * r_v) / (1.0 + w * kk * slope * inv_c_alpha + w * w * slope * inv_m);
+    dz = kk * (slope * ex1 * inv_c_alpha - rho);
     e.x1 = ex1;
     e.v = r_v - w * slope * inv_m * ex1;
     e.x2 = r_x2 + w * dz;
@@ -362,7 +358,7 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
 
 double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    const double c_alpha = cm->p.c_alpha, eta = cm->modes.eta, inv_m = cm->inv_m, accel = cm->accel;
+    const double inv_c_alpha = 1.0 / cm->p.c_alpha, eta = cm->modes.eta, inv_m = cm->inv_m, accel = cm->accel;
     memory_sums s;
     complex_pair ell[BLOCKS], mu[BLOCKS], pull[BLOCKS], Ft[BLOCKS], Zt[BLOCKS], W[BLOCKS];
     double r[STAGES], X[STAGES], F[STAGES], V[STAGES], Z[STAGES], travel[STAGES];
@@ -377,8 +373,8 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
         ell[l] = reciprocal(den);
         hl_ell = times(hl, ell[l]);
         mu[l] = times(hl, hl);
-        mu[l].re = mu[l].re * inv_m + hl_ell.re / c_alpha;
-        mu[l].im = mu[l].im * inv_m + hl_ell.im / c_alpha;
+        mu[l].re = mu[l].re * inv_m + hl_ell.re * inv_c_alpha;
+        mu[l].im = mu[l].im * inv_m + hl_ell.im * inv_c_alpha;
         pull[l] = times(hl_ell, s.p[l]);
     }
     for (i = 0; i < STAGES; i++) {
@@ -396,7 +392,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     to_blocks(F, Ft);
     for (l = 0; l < BLOCKS; l++) {
         const complex_pair hl = h_lambda(h, l);
-        complex_pair force = {Ft[l].re / c_alpha - s.p[l].re, Ft[l].im / c_alpha - s.p[l].im};
+        complex_pair force = {Ft[l].re * inv_c_alpha - s.p[l].re, Ft[l].im * inv_c_alpha - s.p[l].im};
         Zt[l] = times(ell[l], force);
         W[l] = times(hl, Zt[l]);
     }
