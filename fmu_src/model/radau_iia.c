@@ -234,16 +234,18 @@ static complex_pair with_d0(int l, double sum0, complex_pair sum_l)
 }
 
 /* The spring's force at an elastic indentation, and its slope there,
- * n F / X for F = K X^n. */
+ * n F / X for F = K X^n (for the Hertz sphere's n = 1.5, 1.5 K sqrt(X),
+ * without the division). */
 static inline double force_and_slope(const contact_model *cm, double K, double X, double *slope)
 {
+    const double n = cm->p.spring_exponent;
     double F;
     if (!(X > 0.0)) {
         *slope = 0.0;
         return 0.0;
     }
     F = spring_force(cm, K, X);
-    *slope = cm->p.spring_exponent * F / X;
+    *slope = n == 1.5 ? 1.5 * K * sqrt(X) : n * F / X;
     return F;
 }
 
@@ -476,7 +478,7 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
  * output (of the stage order 5), from its divided differences. */
 void radau_indentation_polynomial(const contact_state *s, const contact_state *trial, double p[STAGES + 1])
 {
-    double node[STAGES + 1], y[STAGES + 1];
+    double node[STAGES + 1], y[STAGES + 1], inverse_gap[STAGES][STAGES + 1];
     int i, j;
     node[0] = 0.0;
     y[0] = s->x1;
@@ -484,9 +486,12 @@ void radau_indentation_polynomial(const contact_state *s, const contact_state *t
         node[i + 1] = radau_c[i];
         y[i + 1] = i < STAGES - 1 ? trial->x1_inner[i] : trial->x1;
     }
+    for (j = 1; j <= STAGES; j++) /* the nodes' gaps' reciprocals first: all independent of y */
+        for (i = STAGES; i >= j; i--)
+            inverse_gap[j - 1][i] = 1.0 / (node[i] - node[i - j]);
     for (j = 1; j <= STAGES; j++)
         for (i = STAGES; i >= j; i--)
-            y[i] = (y[i] - y[i - 1]) / (node[i] - node[i - j]);
+            y[i] = (y[i] - y[i - 1]) * inverse_gap[j - 1][i];
     /* the Newton form y0 + y1 (theta - n0) + y2 (theta - n0)(theta - n1) + ...
      * multiplied out from its innermost term */
     for (i = 0; i <= STAGES; i++)

@@ -1148,7 +1148,7 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
             cells += [f"{x['seconds_per_impact'] * 1e6:.1f}", f"{x['steps']}",
                       f"{x['seconds_per_impact'] / x['steps'] * 1e6:.2f}", f"{error:.1e}"]
         ratios.append(r["springpot"]["seconds_per_impact"] / r["dashpot"]["seconds_per_impact"])
-        cells.append(f"{ratios[-1]:.1f}x")
+        cells.append(f"{ratios[-1]:.2f}x")
         out.append("| " + " | ".join(cells) + " |")
     met = all(q <= CONTROLLED_BAR for q in ratios)
     step_ratios = [r["springpot"]["seconds_per_impact"] / r["springpot"]["steps"]
@@ -1156,7 +1156,7 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
     order = {name: math.log(errors[name][0] / errors[name][-1]) / math.log(counts[name][-1] / counts[name][0])
              for name in errors}
     out += ["", f"The issue's bar, the springpot's impact at most {CONTROLLED_BAR:g}x the dashpot's at both "
-            f"tolerances: **{'met' if met else 'not met'}** ({', '.join(f'{q:.1f}x' for q in ratios)}). "
+            f"tolerances: **{'met' if met else 'not met'}** ({', '.join(f'{q:.2f}x' for q in ratios)}). "
             f"The springpot takes {span(counts['springpot'][0] / counts['dashpot'][0], counts['springpot'][-1] / counts['dashpot'][-1])} "
             f"times the dashpot's steps, and each costs {span(*step_ratios)} "
             "times a dashpot step: its five coupled stages (the simplified Newton iteration in A's eigenbasis) "
