@@ -152,6 +152,24 @@ def test_words_mixed_with_codes_in_one_array():
     assert a.F_peak.tolist() == [fraccontact.impact(damper=2).F_peak, fraccontact.impact(damper=1).F_peak]
 
 
+def test_a_batch_shares_a_springpots_kernel_only_between_runs_alike():
+    """fc_run_batch keeps the springpot's kernel for the next run of the same
+    damper_order, memory_tolerance and kernel floor (dt_max, tolerance):
+    runs that differ in each, interleaved with runs alike, give exactly the
+    figures of each run alone (impact calls fc_run, which builds its own)."""
+    cases = [dict(damper_order=0.5), dict(damper_order=0.3), dict(damper_order=0.5, memory_tolerance=1e-4),
+             dict(damper_order=0.5), dict(damper_order=0.5, tolerance=1e-6),
+             dict(damper_order=0.5, tolerance=1e-6, dt_max=1e-10), dict(damper_order=0.5, dt_max=2e-7),
+             dict(damper_order=0.5), dict(damper_order=0.3)]
+    columns = {name: np.array([case.get(name, default) for case in cases]) for name, default in
+               (("damper_order", 0.5), ("memory_tolerance", 1e-6), ("tolerance", 0.0), ("dt_max", 0.0))}
+    batch = fraccontact.impacts(damper=2, law=2, **columns)
+    for i, case in enumerate(cases):
+        alone = fraccontact.impact(damper=2, law=2, **case)
+        assert (batch.F_peak[i], batch.eps[i], batch.x2_end[i], batch.steps[i]) == (
+            alone.F_peak, alone.eps, alone.x2_end, alone.steps), case
+
+
 # --- item 24: one shape of result ------------------------------------------
 
 RUN_FIELDS = ["t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss", "per_impact", "end",

@@ -162,6 +162,11 @@ MUTANTS = [
            "each stage's indentation off by up to 100 tolerances of its scale; test_claims: the springpot table's "
            "figures against the full G1 history",
            (RADAU, "#define NEWTON_SETTLED 1e-2", "#define NEWTON_SETTLED 1e2")),
+    mutant("kernel-reuse-tolerance", "springpot memory", "a batch reuses a springpot's kernel across "
+           "memory_tolerance values",
+           STRUCTURAL + "; test_api::test_a_batch_shares_a_springpots_kernel_only_between_runs_alike: each run of an "
+           "interleaved batch exactly as alone",
+           (LIFE, "           && k->memory_tolerance == p->memory_tolerance;", "           && 1;")),
     mutant("radau-dense-output", "events", "Radau IIA's dense output through half the step's starting indentation",
            STRUCTURAL + "; F_peak read off a wrong polynomial: test_claims, the springpot table's F_peak against the "
            "full G1 history",
