@@ -31,7 +31,7 @@ static int kernel_fits(const contact_kernel *k, const contact_params *p)
  * fits p, and kept there otherwise (kept may be NULL). */
 static void memory_kernel(contact_modes *m, const contact_params *p, contact_kernel *kept)
 {
-    if (kept && kernel_fits(kept, p) && kept->modes <= CONTACT_MAX_MODES) {
+    if (kept && kernel_fits(kept, p)) { /* only a kernel that fits is kept */
         m->modes = kept->modes;
         m->eta = kept->eta;
         memcpy(m->a, kept->a, kept->modes * sizeof m->a[0]);

@@ -5,9 +5,9 @@
  * eliminated in the eigenbasis of the method's matrix A: per mode and
  * trial three reciprocals of 1 + h b lambda, and the stages' unknowns are
  * the five elastic indentations, solved together by the simplified Newton
- * iteration in the same eigenbasis (E. Hairer and G. Wanner, Solving Ordinary Differential Equations II,
- * IV.5 and IV.8; Guglielmi and Hairer integrate fractional ODEs as such
- * stiff augmented systems with Radau IIA). */
+ * iteration in the same eigenbasis (E. Hairer and G. Wanner, Solving
+ * Ordinary Differential Equations II, IV.5 and IV.8; Guglielmi and Hairer
+ * integrate fractional ODEs as such stiff augmented systems with Radau IIA). */
 #include <float.h>
 #include <math.h>
 #include <string.h>
