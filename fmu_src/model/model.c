@@ -70,6 +70,7 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
     cm->peak_length = 0.0;
     cm->modes.modes = 0;
     cm->modes.h = 0.0;
+    cm->modes.radau_h = 0.0;
     if (compressed_memory(cm))
         memory_kernel(&cm->modes, p, kept);
     pad_modes(&cm->modes);
@@ -257,6 +258,7 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->modes = f->modes;
     t->eta = f->eta;
     t->h = f->h;
+    t->radau_h = 0.0; /* radau_d is not copied */
     t->sum_p = f->sum_p;
     t->sum_q = f->sum_q;
     memcpy(t->a, f->a, bytes);

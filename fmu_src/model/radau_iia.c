@@ -3,7 +3,8 @@
  * stiff modes cost it little order, where an ESDIRK integrates them to its
  * stage order 2 (docs/numerics.md). The modes are linear, so they are
  * eliminated in the eigenbasis of the method's matrix A: per mode and
- * trial three reciprocals of 1 + h b lambda, and the stages' unknowns are
+ * trial three reciprocals of 1 + h b lambda (kept for the modes' update
+ * once the trial is accepted), and the stages' unknowns are
  * the five elastic indentations, solved together by the simplified Newton
  * iteration in the same eigenbasis (E. Hairer and G. Wanner, Solving
  * Ordinary Differential Equations II, IV.5 and IV.8; Guglielmi and Hairer
@@ -152,7 +153,8 @@ static void from_blocks(const complex_pair z[BLOCKS], double x[STAGES])
  * needs d_0 d_l too: for l > 0 that is (lambda_0 d_0 - lambda_l d_l) /
  * (lambda_0 - lambda_l), from p_0 and p_l). The three reciprocals by one
  * division of their product, whose size, (h b)^5 at most, stays far from
- * overflowing for any step and mode. */
+ * overflowing for any step and mode; the pass keeps them in radau_d (d_0
+ * and 1/|1 + h b lambda_l|^2 for the pairs) for the update of the modes. */
 typedef struct {
     complex_pair p[BLOCKS], q[BLOCKS];
     double pp0, qq0, relaxed;
@@ -162,15 +164,16 @@ typedef struct {
  * lanes in their order, and the lanes are added in a fixed order after, so
  * that a CPU's vector width changes no bit of them (C99 contracts no
  * multiply-add). The modes are padded to whole lanes with a = b = phi = 0,
- * which add exact zeros. */
+ * which add exact zeros. The lanes are local, so that they stay in the
+ * vector registers. */
 enum { SUM_P0, SUM_Q0, SUM_PP0, SUM_QQ0, SUM_RELAXED, SUM_P1R, SUM_P1I, SUM_Q1R, SUM_Q1I, SUM_P2R, SUM_P2I,
        SUM_Q2R, SUM_Q2I, SUMS };
 
-static inline ALWAYS_INLINE void memory_sums_in_lanes(const contact_modes *m, double h,
-                                                       double lane[SUMS][CONTACT_MODE_LANES])
+static inline ALWAYS_INLINE void memory_sums_in_lanes(contact_modes *m, double h, double sum[SUMS])
 {
     const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
+    double lane[SUMS][CONTACT_MODE_LANES];
     size_t j;
     int k, n;
     for (n = 0; n < SUMS; n++)
@@ -186,6 +189,9 @@ static inline ALWAYS_INLINE void memory_sums_in_lanes(const contact_modes *m, do
             const double inv = 1.0 / (D0 * (N1 * N2));
             const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
             const double apd = ap * d0, ad = a * d0, ak1 = a * k1, apk1 = ap * k1, ak2 = a * k2, apk2 = ap * k2;
+            m->radau_d[0][j + k] = d0;
+            m->radau_d[1][j + k] = k1;
+            m->radau_d[2][j + k] = k2;
             lane[SUM_RELAXED][k] += apd * (x * l0);
             lane[SUM_P0][k] += apd;
             lane[SUM_Q0][k] += ad;
@@ -201,21 +207,20 @@ static inline ALWAYS_INLINE void memory_sums_in_lanes(const contact_modes *m, do
             lane[SUM_Q2I][k] -= ak2 * v2;
         }
     }
-}
-
-CPU_VERSIONS(memory_sums_in_lanes, (const contact_modes *m, double h, double lane[SUMS][CONTACT_MODE_LANES]),
-             (m, h, lane))
-
-static void memory_sums_of(const contact_modes *m, double h, memory_sums *s)
-{
-    double lane[SUMS][CONTACT_MODE_LANES], sum[SUMS];
-    int k, n;
-    CPU_VERSION(memory_sums_in_lanes, (m, h, lane));
     for (n = 0; n < SUMS; n++) {
         sum[n] = lane[n][0];
         for (k = 1; k < CONTACT_MODE_LANES; k++)
             sum[n] += lane[n][k];
     }
+}
+
+CPU_VERSIONS(memory_sums_in_lanes, (contact_modes *m, double h, double sum[SUMS]), (m, h, sum))
+
+static void memory_sums_of(contact_modes *m, double h, memory_sums *s)
+{
+    double sum[SUMS];
+    CPU_VERSION(memory_sums_in_lanes, (m, h, sum));
+    m->radau_h = h;
     s->p[0].re = sum[SUM_P0], s->p[0].im = 0.0, s->q[0].re = sum[SUM_Q0], s->q[0].im = 0.0;
     s->p[1].re = sum[SUM_P1R], s->p[1].im = sum[SUM_P1I], s->q[1].re = sum[SUM_Q1R], s->q[1].im = sum[SUM_Q1I];
     s->p[2].re = sum[SUM_P2R], s->p[2].im = sum[SUM_P2I], s->q[2].re = sum[SUM_Q2R], s->q[2].im = sum[SUM_Q2I];
@@ -259,16 +264,18 @@ static inline double force_and_slope(const contact_model *cm, double K, double X
 #define NEWTON_LIMIT 30
 
 /* The stages' elastic indentations X from X + G F(X) = r, G = T diag(mu)
- * T^-1, from the start's motion: Newton's method with the Jacobian
+ * T^-1, from the start's motion r (its coordinates rho) and a first guess
+ * X (its coordinates xi): Newton's method with the Jacobian
  * I + G diag(F'(X)) taken as I + sigma G, sigma the mean slope of F at the
  * first guess, which A's eigenbasis inverts as 1 / (1 + sigma mu_l),
  * coordinate by coordinate: no linear system. Where the slopes differ
  * little across the step, as everywhere but at an onset, it converges
  * nearly as fast as Newton's method. 0 when it did not converge. */
 static int stage_indentations(const contact_model *cm, double K, const complex_pair mu[BLOCKS],
-                              const double r[STAGES], double X[STAGES], double F[STAGES])
+                              const complex_pair rho[BLOCKS], complex_pair xi[BLOCKS], double X[STAGES],
+                              double F[STAGES])
 {
-    complex_pair rho[BLOCKS], xi[BLOCKS], inverse[BLOCKS];
+    complex_pair inverse[BLOCKS];
     const double settled = NEWTON_SETTLED * cm->p.tolerance;
     double slope, sigma = 0.0, previous = INFINITY;
     int i, l, it;
@@ -281,8 +288,6 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
         const complex_pair jacobian = {1.0 + sigma * mu[l].re, sigma * mu[l].im};
         inverse[l] = reciprocal(jacobian);
     }
-    to_blocks(r, rho);
-    to_blocks(X, xi);
     for (it = 0; it < NEWTON_LIMIT; it++) { /* F is the spring's force at X */
         complex_pair Ft[BLOCKS];
         double change = 0.0, scale = DBL_MIN;
@@ -321,19 +326,20 @@ typedef struct {
     double x1, v, x2, memory;
 } radau_errors;
 
+/* e . (Y - y_n) for x1, v and x2 (radau_e). */
+typedef struct {
+    double x1, v, x2;
+} stage_differences;
+
 static radau_errors filtered_errors(const contact_model *cm, const contact_state *in, double h, double K,
-                                    const memory_sums *s, const double X[STAGES], const double V[STAGES],
-                                    const double travel[STAGES], const complex_pair W[BLOCKS])
+                                    const memory_sums *s, stage_differences d, const complex_pair W[BLOCKS])
 {
     const double w = radau_lambda[0][0] * h, inv_c_alpha = 1.0 / cm->p.c_alpha, inv_m = cm->inv_m, z_n = in->x2_rate;
-    double r_x1 = w * (in->v - z_n), r_v = w * (cm->accel - inv_m * in->F), r_x2 = w * z_n, rho, kk, slope, ex1, dz;
+    const double r_x1 = w * (in->v - z_n) + d.x1, r_v = w * (cm->accel - inv_m * in->F) + d.v;
+    const double r_x2 = w * z_n + d.x2;
+    double rho, kk, slope, ex1, dz;
     radau_errors e;
-    int i, l;
-    for (i = 0; i < STAGES; i++) {
-        r_x1 += radau_e[i] * (X[i] - in->x1);
-        r_v += radau_e[i] * (V[i] - in->v);
-        r_x2 += radau_e[i] * travel[i];
-    }
+    int l;
     /* sum a d_0 r_phi with r_phi = w (z_n - b phi) + e . (Phi - phi) */
     rho = w * z_n * s->q[0].re - s->relaxed - RADAU_E_SUM * s->p[0].re;
     for (l = 0; l < BLOCKS; l++) {
@@ -358,36 +364,53 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
     return e;
 }
 
+/* Re sum_l w_l z_l: a row vector's product with the vector of coordinates z
+ * (coordinate_weight). */
+static double weighted(const double w_t[STAGES], const complex_pair z[BLOCKS])
+{
+    double sum = 0.0;
+    int l;
+    for (l = 0; l < BLOCKS; l++)
+        sum += times(coordinate_weight(w_t, l), z[l]).re;
+    return sum;
+}
+
 double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
     const double inv_c_alpha = 1.0 / cm->p.c_alpha, eta = cm->modes.eta, inv_m = cm->inv_m, accel = cm->accel;
+    const double x1 = in->x1, v = in->v, slide = in->v - in->x2_rate;
     memory_sums s;
-    complex_pair ell[BLOCKS], mu[BLOCKS], pull[BLOCKS], Ft[BLOCKS], Zt[BLOCKS], W[BLOCKS];
-    double r[STAGES], X[STAGES], F[STAGES], V[STAGES], Z[STAGES], travel[STAGES];
-    double impulse = 0.0, work = 0.0, error;
+    complex_pair ell[BLOCKS], mu[BLOCKS], rho[BLOCKS], xi[BLOCKS], Ft[BLOCKS], Zt[BLOCKS], W[BLOCKS], AFt[BLOCKS];
+    double X[STAGES], F[STAGES], Z[STAGES];
+    double impulse = 0.0, work = 0.0, error, e_c = 0.0, e_X = 0.0; /* e . c, e . (X - x1) */
+    stage_differences d;
     radau_errors e;
-    int i, k, l;
+    int i, l;
     memory_sums_of(&cm->modes, h, &s);
+    /* The start's motion r = x1 + c h v + c^2 h^2 accel / 2 + the memory's
+     * pull, and the first guess x1 + c h (v - x2'), in the coordinates,
+     * where the vectors 1, c = A 1 and c^2 = 2 A c (the collocation
+     * conditions) have the coordinates 1, lambda_l and 2 lambda_l^2. */
     for (l = 0; l < BLOCKS; l++) {
-        const complex_pair hl = h_lambda(h, l);
-        complex_pair den = times(hl, s.q[l]), hl_ell;
+        const complex_pair hl = h_lambda(h, l), hl2 = times(hl, hl);
+        complex_pair den = times(hl, s.q[l]), hl_ell, pull;
         den.re += eta;
         ell[l] = reciprocal(den);
         hl_ell = times(hl, ell[l]);
-        mu[l] = times(hl, hl);
-        mu[l].re = mu[l].re * inv_m + hl_ell.re * inv_c_alpha;
-        mu[l].im = mu[l].im * inv_m + hl_ell.im * inv_c_alpha;
-        pull[l] = times(hl_ell, s.p[l]);
+        mu[l].re = hl2.re * inv_m + hl_ell.re * inv_c_alpha;
+        mu[l].im = hl2.im * inv_m + hl_ell.im * inv_c_alpha;
+        pull = times(hl_ell, s.p[l]);
+        rho[l].re = x1 + hl.re * v + hl2.re * accel + pull.re;
+        rho[l].im = hl.im * v + hl2.im * accel + pull.im;
+        xi[l].re = x1 + hl.re * slide;
+        xi[l].im = hl.im * slide;
     }
-    for (i = 0; i < STAGES; i++) {
-        const double ch = radau_c[i] * h;
-        r[i] = in->x1 + ch * (in->v + 0.5 * ch * accel) + from_blocks_at(pull, i);
-        X[i] = in->x1 + ch * (in->v - in->x2_rate);
-    }
+    for (i = 0; i < STAGES; i++)
+        X[i] = x1 + radau_c[i] * h * slide;
     *out = *in;
     out->t = in->t + h;
     out->step = h;
-    if (!stage_indentations(cm, K, mu, r, X, F)) {
+    if (!stage_indentations(cm, K, mu, rho, xi, X, F)) {
         out->error = INFINITY;
         return 0.0;
     }
@@ -397,22 +420,26 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
         complex_pair force = {Ft[l].re * inv_c_alpha - s.p[l].re, Ft[l].im * inv_c_alpha - s.p[l].im};
         Zt[l] = times(ell[l], force);
         W[l] = times(hl, Zt[l]);
+        AFt[l] = times(hl, Ft[l]);
     }
     from_blocks(Zt, Z);
-    from_blocks(W, travel);
     for (i = 0; i < STAGES; i++) {
-        double AF = 0.0;
-        for (k = 0; k < STAGES; k++)
-            AF += radau_a[i][k] * F[k];
-        V[i] = in->v + h * (radau_c[i] * accel - inv_m * AF);
         impulse += h * radau_a[STAGES - 1][i] * F[i];
         work += h * radau_a[STAGES - 1][i] * F[i] * Z[i];
+        e_c += radau_e[i] * radau_c[i];
+        e_X += radau_e[i] * (X[i] - x1);
     }
-    e = filtered_errors(cm, in, h, K, &s, X, V, travel, W);
+    /* e . (V - v) with V = v + h (c accel - A F / m), h A F's coordinates
+     * h lambda_l times F's, and the travel's e . h A Z; the last stage's v
+     * is v + h accel - the impulse / m (c_5 = 1) */
+    d.x1 = e_X;
+    d.v = h * accel * e_c - inv_m * weighted(radau_e_t, AFt);
+    d.x2 = weighted(radau_e_t, W);
+    e = filtered_errors(cm, in, h, K, &s, d, W);
     out->x1 = X[STAGES - 1];
-    out->v = V[STAGES - 1];
+    out->v = v + h * accel - inv_m * impulse;
     out->F = F[STAGES - 1];
-    out->x2 = in->x2 + travel[STAGES - 1];
+    out->x2 = in->x2 + from_blocks_at(W, STAGES - 1);
     out->E_diss = in->E_diss + work;
     out->x2_rate1 = Z[0];
     memcpy(out->x2_rate_inner, Z + 1, sizeof out->x2_rate_inner);
@@ -423,12 +450,12 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     return impulse;
 }
 
-/* Each mode to the last stage's value, elementwise: any vector width gives
- * the same bits. */
+/* Each mode to the last stage's value, elementwise from the reciprocals the
+ * trial's pass kept: any vector width gives the same bits. */
 static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, double h, const complex_pair tau[BLOCKS],
                                                       const complex_pair tau_W[BLOCKS])
 {
-    const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
+    const double r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
     const double t0 = tau[0].re, t1r = tau[1].re, t1i = tau[1].im, t2r = tau[2].re, t2i = tau[2].im;
     const double w0 = tau_W[0].re, w1r = tau_W[1].re, w1i = tau_W[1].im, w2r = tau_W[2].re, w2i = tau_W[2].im;
@@ -436,14 +463,13 @@ static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, double h,
 #pragma omp simd
     for (j = 0; j < m->modes; j++) {
         const double x = h * m->b[j], phi = m->phi[j];
-        const double D0 = 1.0 + x * l0;
-        const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
-        const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
+        const double u1 = 1.0 + x * r1, v1 = x * i1;
+        const double u2 = 1.0 + x * r2, v2 = x * i2;
         /* Re(tau (phi + W) / s) = Re(tau (phi + W) conj(s)) / |s|^2 for s = 1 + x lambda */
         const double n0 = phi * t0 + w0;
         const double n1 = (phi * t1r + w1r) * u1 + (phi * t1i + w1i) * v1;
         const double n2 = (phi * t2r + w2r) * u2 + (phi * t2i + w2i) * v2;
-        m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));
+        m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[2][j]);
     }
 }
 
@@ -461,6 +487,10 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     double Z[STAGES];
     complex_pair Zt[BLOCKS], tau[BLOCKS], tau_W[BLOCKS];
     int l;
+    if (m->radau_h != h) { /* another trial came after it (an event's search) */
+        memory_sums unused;
+        memory_sums_of(m, h, &unused);
+    }
     Z[0] = trial->x2_rate1;
     memcpy(Z + 1, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
     Z[STAGES - 1] = trial->x2_rate;
@@ -472,34 +502,33 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     CPU_VERSION(modes_to_last_stage, (m, h, tau, tau_W));
 }
 
+/* The dense output: the polynomial through (theta_i, y_i) at the nodes
+ * theta = 0 and c has the coefficients M y, M the inverse of the nodes'
+ * Vandermonde matrix, M_ki the coefficient of theta^k in the i-th Lagrange
+ * polynomial (computed in exact rational arithmetic on the nodes' doubles;
+ * tests/test_contact.c checks that it interpolates). */
+static const double radau_dense[STAGES + 1][STAGES + 1] = {
+    {1.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {-25.0, 27.78093394406464, -3.641478498049213, 1.2525477211691185, -0.5920031671845428, 0.20000000000000004},
+    {150.0, -208.02785730090133, 77.88337605511782, -29.16741431782969, 14.111895563613205, -4.800000000000002},
+    {-350.0, 524.1878839694918, -264.89491356822634, 137.90290440413474, -72.39587480540027, 25.200000000000006},
+    {350.0, -543.8283560361325, 317.67586907995275, -202.09087094360737, 123.04335789978718, -44.80000000000001},
+    {-126.0, 199.88739542347736, -127.02285306879499, 92.1028331361332, -64.16737549081559, 25.200000000000006}};
+
 /* x1 over a trial from *s to *trial as a polynomial in theta = tau / h,
  * p[0] + p[1] theta + ... + p[5] theta^5: the collocation polynomial
  * through x1 at the step's start and at the five stages, Radau IIA's dense
- * output (of the stage order 5), from its divided differences. */
+ * output (of the stage order 5). */
 void radau_indentation_polynomial(const contact_state *s, const contact_state *trial, double p[STAGES + 1])
 {
-    double node[STAGES + 1], y[STAGES + 1], inverse_gap[STAGES][STAGES + 1];
-    int i, j;
-    node[0] = 0.0;
+    double y[STAGES + 1];
+    int i, k;
     y[0] = s->x1;
-    for (i = 0; i < STAGES; i++) {
-        node[i + 1] = radau_c[i];
+    for (i = 0; i < STAGES; i++)
         y[i + 1] = i < STAGES - 1 ? trial->x1_inner[i] : trial->x1;
-    }
-    for (j = 1; j <= STAGES; j++) /* the nodes' gaps' reciprocals first: all independent of y */
-        for (i = STAGES; i >= j; i--)
-            inverse_gap[j - 1][i] = 1.0 / (node[i] - node[i - j]);
-    for (j = 1; j <= STAGES; j++)
-        for (i = STAGES; i >= j; i--)
-            y[i] = (y[i] - y[i - 1]) * inverse_gap[j - 1][i];
-    /* the Newton form y0 + y1 (theta - n0) + y2 (theta - n0)(theta - n1) + ...
-     * multiplied out from its innermost term */
-    for (i = 0; i <= STAGES; i++)
-        p[i] = 0.0;
-    p[0] = y[STAGES];
-    for (j = STAGES - 1; j >= 0; j--) {
-        for (i = STAGES - j; i > 0; i--)
-            p[i] = p[i - 1] - node[j] * p[i];
-        p[0] = y[j] - node[j] * p[0];
+    for (k = 0; k <= STAGES; k++) {
+        p[k] = 0.0;
+        for (i = 0; i <= STAGES; i++)
+            p[k] += radau_dense[k][i] * y[i];
     }
 }

@@ -155,8 +155,13 @@ MUTANTS = [
     mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update divides the second complex pair's "
            "term by the wrong pair's modulus",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage",
-           (RADAU, "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N1)) / (D0 * (N1 * N2));",
-            "m->phi[j] = (n0 * (N1 * N2) + D0 * (n1 * N2 + n2 * N2)) / (D0 * (N1 * N2));")),
+           (RADAU, "m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[2][j]);",
+            "m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[1][j]);")),
+    mutant("radau-kept-reciprocals", "time scheme", "Radau IIA: the modes' update takes the kept reciprocals "
+           "whatever trial's step they were built for",
+           STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage: the update of a model copied "
+           "without them",
+           (RADAU, "    if (m->radau_h != h) {", "    if (0 && m->radau_h != h) {")),
     mutant("radau-newton-settled", "time scheme", "Radau IIA: the stages' simplified Newton iteration stops "
            "1e4 times early (100 tolerances of the largest indentation left to the root, not a hundredth)",
            "each stage's indentation off by up to 100 tolerances of its scale; test_claims: the springpot table's "
@@ -171,6 +176,10 @@ MUTANTS = [
            STRUCTURAL + "; F_peak read off a wrong polynomial: test_claims, the springpot table's F_peak against the "
            "full G1 history",
            (RADAU, "    y[0] = s->x1;", "    y[0] = 0.5 * s->x1;")),
+    mutant("radau-dense-table", "events", "Radau IIA's dense output: one entry of its table ×(1 + 1e-9)",
+           "theta's coefficient off by 2.8e-8 of the second stage's x1; test_contact "
+           "test_radau_dense_output_interpolates: a quintic's coefficients within 1e-12",
+           (RADAU, "{-25.0, 27.78093394406464,", "{-25.0, 27.78093394406464 * (1.0 + 1e-9),")),
     mutant("radau-estimate-memory", "time scheme", "Radau IIA: the error estimate's filter without the modes' own "
            "residuals",
            "the estimate changes, and with it the steps; test_claims::test_the_springpot_table_of_error_controlled_steps: "
