@@ -504,6 +504,34 @@ static void test_radau_dense_output_interpolates(void)
     CHECK(worst <= 1e-12, "the dense output's coefficients are the quintic's within %.2g", worst);
 }
 
+/* A copied model steps as its original, to the bit, whatever the memory
+ * it was copied into held before: here every byte 0xff (NaN), which the
+ * springpot's passes would sum in the modes padded to whole lanes were
+ * they not zeroed in the copy too. */
+static void test_a_copy_steps_as_its_original(void)
+{
+    contact_params p;
+    contact_model cm, copy;
+    contact_state original, copied;
+    double v0, m, h, K;
+    contact_default_params(&p);
+    contact_default_striker(&v0, &m);
+    p.law = CONTACT_LAW_HERTZ;
+    p.damper = CONTACT_DAMPER_SPRINGPOT;
+    p.tolerance = 1e-6;
+    contact_start(&cm, &p, v0, m);
+    contact_advance(&cm, 3e-4);
+    memset(&copy, 0xff, sizeof copy);
+    contact_copy(&copy, &cm);
+    h = cm.s.h_next, K = spring_stiffness(&cm, cm.s.n + 1);
+    memset(&original, 0, sizeof original);
+    memset(&copied, 0, sizeof copied);
+    radau_step(&cm, &cm.s, h, K, &original);
+    radau_step(&copy, &copy.s, h, K, &copied);
+    CHECK(cm.modes.modes % CONTACT_MODE_LANES != 0 && memcmp(&original, &copied, sizeof original) == 0,
+          "a copy's step (%zu modes) is its original's: x1 %.17g and %.17g", cm.modes.modes, copied.x1, original.x1);
+}
+
 /* contact_check_params counts a springpot's modes only below
  * CONTACT_MEMORY_FLOOR: at the floor every alpha and memory_tolerance fits
  * CONTACT_MAX_MODES (and a higher floor needs fewer). Checked here over
@@ -586,6 +614,7 @@ int main(void)
     test_springpot_onset_step();
     test_radau_modes_are_the_last_stage();
     test_radau_dense_output_interpolates();
+    test_a_copy_steps_as_its_original();
     test_radau_same_bits_at_every_vector_width();
     test_kernels_above_the_floor_fit();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);

@@ -252,7 +252,8 @@ void contact_copy(contact_model *to, const contact_model *from)
     const contact_modes *f = &from->modes;
     contact_modes *t = &to->modes;
     const size_t bytes = f->modes * sizeof f->a[0];
-    /* all but the modes, then the modes' scalars and the used part of each array */
+    /* all but the modes, then the modes' scalars and the used part of each
+     * array, padded as the original's */
     memcpy(to, from, offsetof(contact_model, modes));
     to->history = from->history;
     t->modes = f->modes;
@@ -269,4 +270,5 @@ void contact_copy(contact_model *to, const contact_model *from)
     memcpy(t->keep, f->keep, bytes);
     memcpy(t->rate1, f->rate1, bytes);
     memcpy(t->rate2, f->rate2, bytes);
+    pad_modes(t);
 }
