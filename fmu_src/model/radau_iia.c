@@ -382,7 +382,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     memory_sums s;
     complex_pair ell[BLOCKS], mu[BLOCKS], rho[BLOCKS], xi[BLOCKS], Ft[BLOCKS], Zt[BLOCKS], W[BLOCKS], AFt[BLOCKS];
     double X[STAGES], F[STAGES], Z[STAGES];
-    double impulse = 0.0, work = 0.0, error, e_c = 0.0, e_X = 0.0; /* e . c, e . (X - x1) */
+    double impulse = 0.0, work = 0.0, error, e_X = 0.0; /* e . (X - x1) */
     stage_differences d;
     radau_errors e;
     int i, l;
@@ -426,14 +426,15 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     for (i = 0; i < STAGES; i++) {
         impulse += h * radau_a[STAGES - 1][i] * F[i];
         work += h * radau_a[STAGES - 1][i] * F[i] * Z[i];
-        e_c += radau_e[i] * radau_c[i];
         e_X += radau_e[i] * (X[i] - x1);
     }
     /* e . (V - v) with V = v + h (c accel - A F / m), h A F's coordinates
-     * h lambda_l times F's, and the travel's e . h A Z; the last stage's v
-     * is v + h accel - the impulse / m (c_5 = 1) */
+     * h lambda_l times F's, and e . c = sum (bhat - b) = -gamma_0 (c = A 1,
+     * and the embedded weights with gamma_0 sum to 1); the travel's
+     * e . h A Z; the last stage's v is v + h accel - the impulse / m
+     * (c_5 = 1) */
     d.x1 = e_X;
-    d.v = h * accel * e_c - inv_m * weighted(radau_e_t, AFt);
+    d.v = -h * accel * radau_lambda[0][0] - inv_m * weighted(radau_e_t, AFt);
     d.x2 = weighted(radau_e_t, W);
     e = filtered_errors(cm, in, h, K, &s, d, W);
     out->x1 = X[STAGES - 1];
