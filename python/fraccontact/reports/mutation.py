@@ -172,6 +172,11 @@ MUTANTS = [
            STRUCTURAL + "; test_api::test_a_batch_shares_a_springpots_kernel_only_between_runs_alike: each run of an "
            "interleaved batch exactly as alone",
            (LIFE, "           && k->memory_tolerance == p->memory_tolerance;", "           && 1;")),
+    mutant("copy-padding", "springpot memory", "contact_copy leaves the modes padded to whole lanes as the "
+           "memory it copies into held them",
+           STRUCTURAL + "; test_contact test_a_copy_steps_as_its_original: a copy into 0xff bytes steps as its "
+           "original, to the bit",
+           (LIFE, "    pad_modes(t);\n}", "}")),
     mutant("radau-dense-output", "events", "Radau IIA's dense output through half the step's starting indentation",
            STRUCTURAL + "; F_peak read off a wrong polynomial: test_claims, the springpot table's F_peak against the "
            "full G1 history",
