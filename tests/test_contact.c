@@ -410,6 +410,21 @@ static void gauss(int n, double M[5][5], double x[5])
     }
 }
 
+/* The default springpot on the Hertz spring at this tolerance, 3e-4 s
+ * into the h20 impact: in contact, its memory's modes stirred. */
+static void start_springpot_in_contact(contact_model *cm, double tolerance)
+{
+    contact_params p;
+    double v0, m;
+    contact_default_params(&p);
+    contact_default_striker(&v0, &m);
+    p.law = CONTACT_LAW_HERTZ;
+    p.damper = CONTACT_DAMPER_SPRINGPOT;
+    p.tolerance = tolerance;
+    contact_start(cm, &p, v0, m);
+    contact_advance(cm, 3e-4);
+}
+
 /* After an accepted error-controlled springpot step each mode is the last
  * stage's: Phi solves (I + h b A) Phi = phi_n 1 + h A Z with the trial's
  * stage rates Z, which radau_advance_modes takes through A's eigenbasis;
@@ -425,18 +440,11 @@ static void gauss(int n, double M[5][5], double x[5])
 static void test_radau_modes_are_the_last_stage(void)
 {
     static const double steps[] = {1e-9, 1e-6, 1e-5, 1e-4};
-    contact_params p;
     contact_model cm, after;
-    double v0, m, c[5], A[5][5];
+    double c[5], A[5][5];
     size_t i, j;
     radau_tableau(c, A);
-    contact_default_params(&p);
-    contact_default_striker(&v0, &m);
-    p.law = CONTACT_LAW_HERTZ;
-    p.damper = CONTACT_DAMPER_SPRINGPOT;
-    p.tolerance = 1e-8;
-    contact_start(&cm, &p, v0, m);
-    contact_advance(&cm, 3e-4);
+    start_springpot_in_contact(&cm, 1e-8);
     CHECK(cm.s.in_contact && cm.modes.modes > 0, "in contact at 3e-4 s with %zu modes", cm.modes.modes);
     for (i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         const double h = steps[i];
@@ -468,9 +476,9 @@ static void test_radau_modes_are_the_last_stage(void)
             scale += fabs(cm.modes.a[j] * after.modes.phi[j]);
         }
         CHECK(worst <= 1e-13, "h = %g: the modes are the last stage's within %.2g of their scale", h, worst);
-        CHECK(fabs(p.c_alpha * (cm.modes.eta * trial.x2_rate + memory) - trial.F) <= 1e-13 * p.c_alpha * scale,
+        CHECK(fabs(cm.p.c_alpha * (cm.modes.eta * trial.x2_rate + memory) - trial.F) <= 1e-13 * cm.p.c_alpha * scale,
               "h = %g: the memory's force %.17g is the spring's %.17g", h,
-              p.c_alpha * (cm.modes.eta * trial.x2_rate + memory), trial.F);
+              cm.p.c_alpha * (cm.modes.eta * trial.x2_rate + memory), trial.F);
     }
 }
 
@@ -510,17 +518,10 @@ static void test_radau_dense_output_interpolates(void)
  * they not zeroed in the copy too. */
 static void test_a_copy_steps_as_its_original(void)
 {
-    contact_params p;
     contact_model cm, copy;
     contact_state original, copied;
-    double v0, m, h, K;
-    contact_default_params(&p);
-    contact_default_striker(&v0, &m);
-    p.law = CONTACT_LAW_HERTZ;
-    p.damper = CONTACT_DAMPER_SPRINGPOT;
-    p.tolerance = 1e-6;
-    contact_start(&cm, &p, v0, m);
-    contact_advance(&cm, 3e-4);
+    double h, K;
+    start_springpot_in_contact(&cm, 1e-6);
     memset(&copy, 0xff, sizeof copy);
     contact_copy(&copy, &cm);
     h = cm.s.h_next, K = spring_stiffness(&cm, cm.s.n + 1);
