@@ -13,6 +13,10 @@
 static const fc_parameter parameters[] = {
     {"v", FC_REAL, AT(v), "m/s", "striker velocity towards the specimen; driven scene: the indentation rate"},
     {"m", FC_REAL, AT(m), "kg", "striker mass; driven scene: 0 = no inertia"},
+    {"v2", FC_REAL, AT(v2), "m/s",
+     "the second body's velocity along the striker's axis: the model's striker moves at the approach speed v - v2"},
+    {"m2", FC_REAL, AT(m2), "kg",
+     "the second body's mass; 0 = held fixed; > 0: the model's striker has the reduced mass m m2/(m + m2)"},
     {"R", FC_REAL, AT(R), "m", "striker tip radius (used only with k = 0)"},
     {"E_i", FC_REAL, AT(E_i), "Pa", "indenter Young's modulus (used only with k = 0)"},
     {"nu_i", FC_REAL, AT(nu_i), "1", "indenter Poisson ratio (used only with k = 0)"},
@@ -57,6 +61,12 @@ const fc_parameter *fc_parameter_at(size_t i) { return i < N_PARAMETERS ? &param
 size_t fc_params_size(void) { return sizeof(fc_params); }
 
 size_t fc_outcome_size(void) { return sizeof(fc_outcome); }
+
+void fc_striker(const fc_params *p, double *v, double *m)
+{
+    *v = p->v - p->v2;
+    *m = contact_reduced_mass(p->m, p->m2);
+}
 
 void fc_model_params(const fc_params *p, contact_params *q)
 {
@@ -117,9 +127,12 @@ void fc_params_default(fc_params *p)
 fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;
+    double v, m;
     fc_model_params(p, &q);
-    if (contact_check_params(&q, msg, len) != 0 || contact_check_striker(&q, q.scene, p->v, p->m, msg, len) != 0
-        || contact_check_resolution(&q, p->v, p->m, msg, len) != 0)
+    fc_striker(p, &v, &m);
+    if (contact_check_params(&q, msg, len) != 0
+        || contact_check_bodies(&q, q.scene, p->v, p->m, p->v2, p->m2, msg, len) != 0
+        || contact_check_resolution(&q, v, m, msg, len) != 0)
         return FC_EINVAL;
     if (!(p->t_end > 0.0) || !isfinite(p->t_end)) {
         contact_reject(msg, len, "t_end", p->t_end, "the time limit must be positive and finite [s]");
@@ -131,7 +144,7 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
     }
     /* A run stops at its first separation after one impact, or where
      * nothing brings the striker back. */
-    if (contact_check_history_span(&q, p->v, p->m, p->t_end, p->impacts == 1 || !(p->g > 0.0), "t_end", msg, len)
+    if (contact_check_history_span(&q, v, m, p->t_end, p->impacts == 1 || !(p->g > 0.0), "t_end", msg, len)
         != 0)
         return FC_EINVAL;
     return FC_OK;
@@ -173,8 +186,11 @@ double fc_drop_velocity(double height)
 int fc_params_warning(const fc_params *p, char *msg, size_t len)
 {
     contact_params q;
+    double v, m;
     fc_model_params(p, &q);
-    return contact_unused_value(&q, msg, len) || contact_step_warning(&q, p->v, p->m, msg, len);
+    fc_striker(p, &v, &m);
+    return contact_unused_value(&q, msg, len) || contact_step_warning(&q, v, m, msg, len)
+           || contact_arrival_warning(&q, v, msg, len);
 }
 
 int fc_error_controlled(const fc_params *p)
@@ -205,11 +221,12 @@ static double contact_time(const fc_params *p)
 {
     contact_params q;
     contact_model cm;
-    double x_ref, t_ref, x_small;
+    double x_ref, t_ref, x_small, v, m;
     fc_model_params(p, &q);
+    fc_striker(p, &v, &m);
     q.damper = CONTACT_DAMPER_DASHPOT; /* the spring's alone: no springpot's memory to build */
-    contact_start(&cm, &q, p->v, p->m);
-    contact_scales(&q, contact_spring_stiffness(&cm, 0), p->v, p->m, &x_ref, &t_ref, &x_small);
+    contact_start(&cm, &q, v, m);
+    contact_scales(&q, contact_spring_stiffness(&cm, 0), v, m, &x_ref, &t_ref, &x_small);
     return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref : 0.0;
 }
 
@@ -234,10 +251,12 @@ double fc_default_output_interval(const fc_params *p)
  * under g: gap0 = v t + g t^2 / 2), or infinity when it never does. */
 static double onset_time(const fc_params *p)
 {
-    double g = driven_rate(p) ? 0.0 : p->g, root = p->v * p->v + 2.0 * g * p->gap0, speed;
-    if (p->gap0 == 0.0 && (p->v > 0.0 || (p->v == 0.0 && g > 0.0)))
+    double g = driven_rate(p) ? 0.0 : p->g, v, m, root, speed;
+    fc_striker(p, &v, &m);
+    root = v * v + 2.0 * g * p->gap0;
+    if (p->gap0 == 0.0 && (v > 0.0 || (v == 0.0 && g > 0.0)))
         return 0.0;
-    speed = root >= 0.0 ? p->v + sqrt(root) : 0.0;
+    speed = root >= 0.0 ? v + sqrt(root) : 0.0;
     return speed > 0.0 ? 2.0 * p->gap0 / speed : INFINITY;
 }
 
@@ -522,13 +541,14 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     double E_diss_onset = 0.0;
     int64_t k = 1;
     int uniform, grid;
-    double dt;
+    double dt, v, m;
     memset(o, 0, sizeof *o);
     if (fc_run_check(p, out ? interval : FC_NO_ROWS, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
     fc_model_params(p, &q);
+    fc_striker(p, &v, &m);
     dt = contact_step_limit(&q);
-    contact_start_with(&cm, &q, p->v, p->m, kernel);
+    contact_start_with(&cm, &q, v, m, kernel);
     watch_run(w, &cm);
     uniform = contact_steps_uniformly(&q);
     grid = rows_on_grid(&q);

@@ -51,6 +51,8 @@ typedef enum {
 typedef struct {
     double v;        /* striker velocity towards the specimen [m/s]; driven scene: the indentation rate */
     double m;        /* striker mass [kg]; driven scene: 0 = no inertia */
+    double v2;       /* the second body's velocity [m/s]: the model's striker moves at v - v2 */
+    double m2;       /* the second body's mass [kg]; 0 = held fixed; > 0: the reduced mass m m2/(m + m2) */
     double R;        /* striker tip radius [m] */
     double E_i;      /* indenter Young's modulus [Pa] */
     double nu_i;     /* indenter Poisson ratio */

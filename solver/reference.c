@@ -173,18 +173,21 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
 {
     fc_outcome *r = &result->outcome;
     contact_params model, *p = &model;
-    const double v0 = params->v, m = params->m, t_end = params->t_end;
+    const double t_end = params->t_end;
+    double v0, m;
     contact_model cm;
     ode o;
     integrator in;
     gsl_odeiv2_system sys;
     double scale[4], x_ref, t_ref, x_small, bracket, y[4], y1[4], t = 0.0;
-    double v_onset = v0, t_onset = 0.0, E_diss_onset = 0.0, F_peak_contact = 0.0;
+    double v_onset, t_onset = 0.0, E_diss_onset = 0.0, F_peak_contact = 0.0;
     long k = 1, brackets = 0;
     int in_contact, out_of_memory = 0, stopped = 0;
     gsl_error_handler_t *previous = gsl_set_error_handler_off();
 
     fc_model_params(params, &model);
+    fc_striker(params, &v0, &m);
+    v_onset = v0;
     if (p->damper != CONTACT_DAMPER_DASHPOT) {
         snprintf(msg, len,
                  "--reference integrates the dashpot (damper = 1) only; a springpot has no ODE for GSL: compare "

@@ -29,6 +29,11 @@ void series_add(series *s, const double row[FC_COLUMNS]);
  * `steps`) would hold more than FC_ROWS_MAX rows. */
 fc_status run_rows_check(const fc_params *p, double interval, double steps, char *msg, size_t len);
 
+/* The model's striker of a run: the relative motion of the striker and the
+ * second body, at the approach speed v - v2 with the reduced mass
+ * (docs/two_bodies.md). */
+void fc_striker(const fc_params *p, double *v, double *m);
+
 /* The model's parameters of a run. */
 void fc_model_params(const fc_params *p, contact_params *q);
 

@@ -131,29 +131,13 @@ static double approach(const bodies *b)
  * prescribed (m = 0). */
 static double proxy_mass(const bodies *b)
 {
-    return b->m > 0.0 && b->m2 > 0.0 ? 1.0 / (1.0 / b->m + 1.0 / b->m2) : b->m;
+    return contact_reduced_mass(b->m, b->m2);
 }
 
 /* What the other forces add to the approach's acceleration. */
 static double other_accel(const bodies *b)
 {
     return b->a - b->a2;
-}
-
-/* The striker's rules applied to the relative motion, whose approach
- * speed and reduced mass the message names as such (the rule's own words
- * say v and m). */
-static int check_relative_motion(const contact_params *p, int scene, const bodies *b, char *why, size_t len)
-{
-    const double u = approach(b), m_r = proxy_mass(b);
-    int n;
-    if (contact_check_striker(p, scene, u, m_r, why, len) == 0)
-        return 0;
-    n = snprintf(why, len, "the relative motion of the two bodies (v - v2 = %g m/s, reduced mass m m2/(m + m2) = %g "
-                 "kg) breaks the striker's rule: ", u, m_r);
-    if (n > 0 && (size_t)n < len)
-        contact_check_striker(p, scene, u, m_r, why + n, len - (size_t)n);
-    return -1;
 }
 
 /* 0 when the inputs are usable in `scene` with the parameters *p (which
@@ -163,27 +147,19 @@ static int check_relative_motion(const contact_params *p, int scene, const bodie
 static int check_bodies(const contact_params *p, int scene, const bodies *b, char *why, size_t len)
 {
     const double mass = proxy_mass(b), accel = p->g + other_accel(b);
-    if (contact_check_striker(p, scene, b->v, b->m, why, len) != 0)
+    if (contact_check_bodies(p, scene, b->v, b->m, b->v2, b->m2, why, len) != 0)
         return -1;
-    if (!isfinite(b->v2))
-        return contact_reject(why, len, "v2", b->v2, "the second body's velocity must be finite [m/s]");
-    if (!(b->m2 == 0.0 || (b->m2 >= DBL_MIN && b->m2 <= DBL_MAX)))
-        return contact_reject(why, len, "m2", b->m2,
-                              "the second body's mass must be positive, finite and not denormal, or 0 (held "
-                              "fixed) [kg]");
     if (!isfinite(b->a))
         return contact_reject(why, len, "a", b->a,
                               "the striker's acceleration from its other forces must be finite [m/s^2]");
     if (!isfinite(b->a2))
         return contact_reject(why, len, "a2", b->a2,
                               "the second body's acceleration from its other forces must be finite [m/s^2]");
-    if (isfinite(b->v) && !isfinite(approach(b)))
-        return contact_reject(why, len, "v2", b->v2, "the approach speed v - v2 must be finite [m/s]");
     if (!isfinite(accel) || (p->damper == CONTACT_DAMPER_DASHPOT && !isfinite(mass * accel * (mass * accel) / p->c)))
         return contact_reject(why, len, "a", b->a,
                               "the approach's acceleration g + a - a2 must be finite, and so must the power "
                               "(m_r (g + a - a2))^2 / c it can dissipate (m_r the reduced mass m m2/(m + m2))");
-    return b->v2 == 0.0 && b->m2 == 0.0 ? 0 : check_relative_motion(p, scene, b, why, len);
+    return 0;
 }
 
 /* Applies a parameter change only if the parameters stay valid. */
@@ -425,7 +401,8 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why)
-        || contact_step_warning(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why))
+        || contact_step_warning(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why)
+        || contact_arrival_warning(&fm->params, approach(&fm->in), why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     if (other_accel(&fm->in) != 0.0 && fm->params.scene == CONTACT_SCENE_DROP)
         return report(fm, FM_WARNING, "logStatusWarning",

@@ -295,6 +295,28 @@ double contact_step_limit(const contact_params *p);
  * run must also be able to hold its energies and powers in doubles. */
 int contact_check_striker(const contact_params *p, int scene, double v, double m, char *msg, size_t len);
 
+/* The mass of the model's striker between a striker of mass m and a second
+ * body of mass m2: the reduced mass m m2/(m + m2) of two free bodies, m
+ * where the second is held (m2 = 0) or the rate is prescribed (m = 0). */
+double contact_reduced_mass(double m, double m2);
+
+/* contact_check_striker for a striker (v, m) and a second body (v2, m2):
+ * each body's own rules (v2 finite; m2 = 0, or positive, finite and not
+ * denormal), and the striker's rules for their relative motion, the
+ * approach speed v - v2 and the reduced mass (docs/two_bodies.md). */
+int contact_check_bodies(const contact_params *p, int scene, double v, double m, double v2, double m2, char *msg,
+                         size_t len);
+
+/* Whether a free flight from x1 (< 0: the gap) at the speed v under the
+ * acceleration a (towards the specimen) ever makes x1 > 0: a > 0, or v > 0
+ * and no deceleration turns it back within the gap. */
+int contact_flight_arrives(double x1, double v, double a);
+
+/* A warning where the drop test's striker, at the approach speed v, never
+ * reaches the specimen from the gap gap0 under g (docs/model.md §9): 1 and
+ * the message naming v, g and gap0, or 0. */
+int contact_arrival_warning(const contact_params *p, double v, char *msg, size_t len);
+
 /* Whether the uniform grids (the central scheme, the full G1 history),
  * whose steps cannot shorten in contact, resolve the first impact of a
  * striker of mass m starting at v (the fastest: CONTACT_RESOLUTION steps

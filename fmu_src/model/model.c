@@ -164,9 +164,16 @@ int contact_never_returns(const contact_model *cm)
      * striker that has not cleared the undeformed surface. */
     if (!memory_at_rest(cm) && !(s->v <= 0.0 && s->x1 + s->x2 <= 0.0))
         return 0;
-    if (s->v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
-        return a < 0.0 && !(s->x1 + 0.5 * s->v * s->v / -a > 0.0);
-    return 1;
+    return !contact_flight_arrives(s->x1, s->v, a);
+}
+
+int contact_flight_arrives(double x1, double v, double a)
+{
+    if (a > 0.0)
+        return 1;
+    if (v > 0.0) /* heading in: it arrives unless a deceleration turns it in the gap first */
+        return !(a < 0.0) || x1 + 0.5 * v * v / -a > 0.0;
+    return 0;
 }
 
 int contact_rests(const contact_model *cm)

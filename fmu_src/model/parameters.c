@@ -1,6 +1,7 @@
 /* The parameters: the paper's defaults, their checks (an error naming the
  * parameter, its value and the rule), the striker's, and the warnings for
  * values that have no effect (docs/model.md §1, §2). */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -280,4 +281,52 @@ int contact_check_striker(const contact_params *p, int scene, double v, double m
     if (p->damper == CONTACT_DAMPER_DASHPOT && m == 0.0 && !isfinite(p->c * v * v))
         return contact_reject(msg, len, "v", v, "the power c v^2 of the dashpot driven at v exceeds double precision");
     return 0;
+}
+
+double contact_reduced_mass(double m, double m2)
+{
+    return m > 0.0 && m2 > 0.0 ? 1.0 / (1.0 / m + 1.0 / m2) : m;
+}
+
+/* The striker's rules applied to the relative motion, whose approach
+ * speed and reduced mass the message names as such (the rule's own words
+ * say v and m). */
+static int check_relative_motion(const contact_params *p, int scene, double u, double m_r, char *msg, size_t len)
+{
+    int n;
+    if (contact_check_striker(p, scene, u, m_r, msg, len) == 0)
+        return 0;
+    n = snprintf(msg, len, "the relative motion of the two bodies (v - v2 = %g m/s, reduced mass m m2/(m + m2) = %g "
+                 "kg) breaks the striker's rule: ", u, m_r);
+    if (n > 0 && (size_t)n < len)
+        contact_check_striker(p, scene, u, m_r, msg + n, len - (size_t)n);
+    return -1;
+}
+
+int contact_check_bodies(const contact_params *p, int scene, double v, double m, double v2, double m2, char *msg,
+                         size_t len)
+{
+    if (contact_check_striker(p, scene, v, m, msg, len) != 0)
+        return -1;
+    if (!isfinite(v2))
+        return contact_reject(msg, len, "v2", v2, "the second body's velocity must be finite [m/s]");
+    if (!(m2 == 0.0 || (m2 >= DBL_MIN && m2 <= DBL_MAX)))
+        return contact_reject(msg, len, "m2", m2,
+                              "the second body's mass must be positive, finite and not denormal, or 0 (held "
+                              "fixed) [kg]");
+    if (isfinite(v) && !isfinite(v - v2))
+        return contact_reject(msg, len, "v2", v2, "the approach speed v - v2 must be finite [m/s]");
+    return v2 == 0.0 && m2 == 0.0 ? 0 : check_relative_motion(p, scene, v - v2, contact_reduced_mass(m, m2), msg, len);
+}
+
+int contact_arrival_warning(const contact_params *p, double v, char *msg, size_t len)
+{
+    char text[3][32];
+    if (p->scene != CONTACT_SCENE_DROP || contact_flight_arrives(-p->gap0, v, p->g))
+        return 0;
+    snprintf(msg, len,
+             "v = %s with g = %s and gap0 = %s: the striker never reaches the specimen (its flight closes the gap "
+             "only with g > 0, or v > 0 and v^2 > -2 g gap0): no impact ever happens",
+             shown(v, text[0]), shown(p->g, text[1]), shown(p->gap0, text[2]));
+    return 1;
 }

@@ -1,9 +1,13 @@
 """The contact model in-process: one run, a batch of runs, a time series.
 
 Parameters: the FMU's variable names (parameters() lists them with units
-and defaults: v, m, R, E_i, nu_i, E_s, nu_s, k, c, law, g1_nodes, dt_max,
-scene, g, gap0, ...), the scheme, the stops t_end and impacts, and height as
-a convenience for v (v = sqrt(2 g h)). impacts() takes arrays for any of
+and defaults: v, m, v2, m2, R, E_i, nu_i, E_s, nu_s, k, c, law, g1_nodes,
+dt_max, scene, g, gap0, ...), the scheme, the stops t_end and impacts, and
+height as a convenience for v (v = sqrt(2 g h)). v2 and m2, the second
+body's velocity and mass, make the striker the two bodies' relative motion
+(the approach speed v - v2, the reduced mass m m2/(m + m2)); the FMU's
+co-simulation inputs a, a2 and coupling are no parameters of a run
+(TypeError says why). impacts() takes arrays for any of
 them, broadcast together. An integer parameter takes a whole number (2 or
 2.0, not 2.5 or True), and an enumerated one also the words of the solver's
 --help and the FMU's modelDescription: law g1/hertz/g1x, scene drop/driven,
@@ -19,7 +23,8 @@ scipy's OptimizeResult.
   Run      what impact() returns, and impacts() with every figure an array of
            the broadcast shape:
              t_onset, v_onset, F_peak, eps, t_contact, x2_end, E_diss: the
-               first impact's figures (NaN when none ended);
+               first impact's figures (NaN when none ended; a striker that
+               never reaches the specimen warns, ParameterWarning);
              per_impact: every finished impact, a list of Impact (None from
                impacts(), whose library call keeps the first only);
              end: an End, the FMU's outputs where the run stopped (t, F_peak,
@@ -59,6 +64,10 @@ NAMES = tuple(p["name"] for p in _lib.PARAMETERS)
 INTEGERS = frozenset(p["name"] for p in _lib.PARAMETERS if p["kind"] == "integer")
 UNITS = dict({p["name"]: p["unit"] for p in _lib.PARAMETERS}, height="m")
 C_INT = np.iinfo(np.intc)
+# The FMU's variables that are no parameters of a library run, and why (docs/python.md).
+CO_SIMULATION_ONLY = ("a", "a2", "coupling")
+NO_MASTER = ("the FMU's inputs a, a2 and coupling are what a co-simulation master feeds at each communication "
+             "step (docs/two_bodies.md); a library run has no master: its striker feels the contact and g only")
 SHOW_AFTER = 3.0  # s: a library call longer than this shows its progress on a terminal
 REDRAW = 0.5      # s between two drawings of that line
 
@@ -172,6 +181,9 @@ def _array(name, value):
 
 
 def _known(params):
+    inputs = sorted(set(params) & set(CO_SIMULATION_ONLY))
+    if inputs:
+        raise TypeError(f"{', '.join(inputs)}: no parameter of a run; {NO_MASTER}")
     unknown = sorted(set(params) - set(NAMES) - {"height"})
     if unknown:
         raise TypeError(f"unknown parameter {', '.join(unknown)}; the parameters are {', '.join(NAMES)} and height")
@@ -467,7 +479,7 @@ def impacts(**params):
         status = _lib.LIB.fc_run_batch_with_progress(len(batch), batch.ctypes.data, out.ctypes.data, progress, None)
     if status != _lib.FC_OK:
         _raise_for_case(batch, out, shape)
-    methods = np.array([_method(batch.ctypes.data + i * batch.itemsize) for i in range(len(batch))])
+    methods = np.array([_method(batch.ctypes.data + i * batch.itemsize) for i in range(len(batch))], dtype=str)
     return _run(out, None, methods.reshape(shape), shape)
 
 
