@@ -322,8 +322,8 @@ int contact_check_bodies(const contact_params *p, int scene, double v, double m,
 int contact_arrival_warning(const contact_params *p, double v, char *msg, size_t len)
 {
     char text[3][32];
-    if (p->scene != CONTACT_SCENE_DROP || contact_flight_arrives(-p->gap0, v, p->g))
-        return 0;
+    if (p->scene != CONTACT_SCENE_DROP || !isfinite(v) || contact_flight_arrives(-p->gap0, v, p->g))
+        return 0; /* a v that is not finite is refused, not warned about */
     snprintf(msg, len,
              "v = %s with g = %s and gap0 = %s: the striker never reaches the specimen (its flight closes the gap "
              "only with g > 0, or v > 0 and v^2 > -2 g gap0): no impact ever happens",
