@@ -116,7 +116,8 @@ def test_the_fmu_warns_at_initialization_and_outputs_no_impact(slave):
     """The drop test's FMU: the same sentence as fmi2Warning when it leaves
     initialization; then its flight, F_peak and eps staying 0."""
     s = slave(v=-1.0)
-    assert [message for _, _, message in s.log if NEVER in message] == [fraccontact.warning(v=-1.0)]
+    assert [(status, message) for status, _, message in s.log if NEVER in message] == \
+        [(1, fraccontact.warning(v=-1.0))]  # fmi2Warning
     for _ in range(10):
         s.step(1e-4)
     assert (s.get("F_peak"), s.get("eps"), s.get("E_diss"), s.get("F")) == (0.0, 0.0, 0.0, 0.0)
@@ -155,6 +156,19 @@ def test_the_two_body_impact_is_one_call_and_the_elastic_closed_form():
     assert r.t_contact == pytest.approx(HERTZ_TC * x_max / u, rel=SCHEME_RTOL["t_contact"], abs=0)
     assert r.eps == pytest.approx(1.0, rel=SCHEME_RTOL["eps"], abs=0)
     assert r.v_onset == u
+
+
+def test_the_solvers_reference_takes_the_two_bodies_too():
+    """--reference (GSL at --rtol 1e-12) with --v2 and --m2: the same closed
+    form, within 1e-10 (100x the reference's tolerance; it measures 1e-14)."""
+    done = subprocess.run([SOLVE, "--reference", "--law", "hertz", "--c", "1e300", "--v", "3", "--m", str(M1),
+                           "--v2", "1", "--m2", str(M2), "--json"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    r = json.loads(done.stdout)
+    x_max = (5 * MR * 2.0 ** 2 / (4 * K)) ** 0.4
+    assert r["F_peak"] == pytest.approx(K * x_max ** 1.5, rel=1e-10, abs=0)
+    assert r["t_contact"] == pytest.approx(HERTZ_TC * x_max / 2.0, rel=1e-10, abs=0)
+    assert r["end"]["v"] == pytest.approx(-2.0, rel=1e-10, abs=0)  # the approach speed, reversed
 
 
 def test_the_two_body_impact_is_the_two_free_bodies_co_simulation():
