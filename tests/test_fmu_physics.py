@@ -138,11 +138,15 @@ def h20_reference():
 
 def test_reference_is_converged(h20_reference):
     """The reference itself: an implicit method (Radau) asked for rtol 1e-12
-    agrees with it to 1.4e-13 (eps; the rest 5e-14 or better): 1e-12, Radau's
-    own tolerance, is far inside the 3e-9 the FMU is held to."""
+    agrees with it far inside the 3e-9 the FMU is held to. Against a
+    25-digit Taylor-series solve of the ODE (mpmath's odefun), each errs up
+    to 2e-13 (DOP853 at 1e-13: 1.4e-13 in eps; Radau: 3.5e-14, and 2e-13 in
+    F_peak with each right-hand side's rounding moved by up to an ulp, as
+    another machine's SIMD paths or libm move it): 1e-11 leaves them a
+    factor 25 and stays 300 times inside the FMU's tolerance."""
     radau = reference_drop(K, C, M, math.sqrt(2 * 9.81 * 0.020), method="Radau", rtol=1e-12)
     for key in ("F_peak", "eps", "t_contact", "x2", "E_diss"):
-        assert radau[key] == pytest.approx(h20_reference[key], rel=1e-12, abs=0), key
+        assert radau[key] == pytest.approx(h20_reference[key], rel=1e-11, abs=0), key
 
 
 @pytest.mark.parametrize("H", [1e-5, 3.3e-6])
