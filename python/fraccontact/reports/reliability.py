@@ -113,7 +113,10 @@ def write(path, s, v, f, hostile_summary):
              "## Scale, threads, soak", "",
              f"- **{s['instances']['instances']:,} instances alive at once** in one process: resident memory "
              f"{s['instances']['rss_before_mib']:.1f} MiB before, {s['instances']['rss_alive_mib']:.1f} MiB with all "
-             f"alive ({s['instances']['kib_per_instance']:.2f} KiB per instance); each then run through an impact "
+             f"alive ({s['instances']['kib_per_instance']:.1f} KiB per instance: an instance holds the contact model "
+             f"twice, its state and its prediction of the next communication step, "
+             f"{s['instances']['bytes_contact_model']:,} B each, most of it the compressed memory's arrays for "
+             f"{s['instances']['max_modes']} modes, whatever the damper); each then run through an impact "
              f"(dt_max = 1e-6 s), {s['instances']['seconds_for_all_impacts']:.2f} s for all; every 997th compared "
              f"with the same instance alone: {'identical' if not s['instances']['sampled_differ_from_alone'] else 'DIFFERENT'}.",
              f"- **{s['threads']['threads']} threads** stepping {s['threads']['instances']} distinct instances at "
