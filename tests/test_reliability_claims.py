@@ -40,3 +40,29 @@ def test_the_memory_per_instance_is_what_an_instance_holds():
     assert f"{measured['kib_per_instance']:.{decimals}f}" == kib, f"measured {measured['kib_per_instance']} KiB"
     per_instance = measured["kib_per_instance"] * 1024
     assert 2 * measured["bytes_contact_model"] <= per_instance < 2 * measured["bytes_contact_model"] + 4096
+
+
+def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
+    """The budget of an input as the harnesses define it, the seconds and
+    the floors of the fuzz tests as CMake and scripts/test set them, and the
+    count CI runs at least, which follows from them."""
+    steps, terms, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
+        r"Each input's work is bounded \(`tests/fuzz_program.h`\): at most ([\d,]+) internal steps in all its steps "
+        r"and ([\d,]+) terms of a full G1 history's sums, so that no input runs long \(`fuzz_replay -timeout=(\d+)` "
+        r"fails one that takes a second of CPU, in every build\)\. CI fuzzes each harness for (\d+) s with ASan and "
+        r"UBSan, then (\d+) s without sanitizers \(`scripts/test`, FUZZ_SECONDS = 60\); the fuzz tests fail below "
+        r"([\d,]+) inputs per second of CPU with the sanitizers and ([\d,]+) without \(`tests/fuzz_rate.py`, which "
+        r"prints each run's count\): on an idle core, CI's fuzzing runs at least ([\d,]+) inputs a harness\.")
+    n = lambda text: int(text.replace(",", ""))
+    program = (ROOT / "tests" / "fuzz_program.h").read_text()
+    assert float(re.search(r"#define BUDGET_STEPS ([\d.]+)", program).group(1)) == n(steps)
+    assert float(re.search(r"#define BUDGET_TERMS ([\d.]+)", program).group(1)) == n(terms)
+    cmake = (ROOT / "CMakeLists.txt").read_text()
+    fuzzer = cmake[cmake.index("function(add_fmi_fuzzer"):cmake.index("endfunction()", cmake.index("function(add_fmi_fuzzer"))]
+    assert re.findall(r"set\(floor (\d+)\)", fuzzer) == [sanitized_floor.replace(",", ""), plain_floor.replace(",", "")]
+    assert f"-timeout={timeout}" in fuzzer
+    assert re.findall(r"fuzz_replay(?:_fmi3)? -timeout=(\d+)", cmake) == [timeout, timeout]
+    assert re.search(r'FRACCONTACT_FUZZ_PLAIN_SECONDS (\d+) CACHE', cmake).group(1) == plain
+    script = (ROOT / "scripts" / "test").read_text()
+    assert '-DFRACCONTACT_FUZZ_SECONDS="$(( ${FUZZ_SECONDS:-60} / 2 ))"' in script and n(sanitized) == 60 // 2
+    assert n(at_least) == n(sanitized) * n(sanitized_floor) + n(plain) * n(plain_floor)

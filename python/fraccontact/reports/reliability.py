@@ -105,6 +105,18 @@ def mutation_section(path):
     return text[start:end + len(MUTATION_END)] + "\n" if 0 <= start < end else ""
 
 
+# What CI's fuzzing runs, from the harnesses' budget (tests/fuzz_program.h) and
+# the fuzz tests' floors (CMakeLists.txt, add_fmi_fuzzer; tests/fuzz_rate.py):
+# tests/test_reliability_claims.py reads both.
+FUZZ_BUDGET = ("Each input's work is bounded (`tests/fuzz_program.h`): at most 1,024 internal steps in all its "
+               "steps and 262,144 terms of a full G1 history's sums, so that no input runs long (`fuzz_replay "
+               "-timeout=1` fails one that takes a second of CPU, in every build). CI fuzzes each harness for 30 s "
+               "with ASan and UBSan, then 10 s without sanitizers (`scripts/test`, FUZZ_SECONDS = 60); the fuzz "
+               "tests fail below 250 inputs per second of CPU with the sanitizers and 1,000 without "
+               "(`tests/fuzz_rate.py`, which prints each run's count): on an idle core, CI's fuzzing runs at least "
+               "17,500 inputs a harness.")
+
+
 def write(path, s, v, f, hostile_summary):
     steps = s["steps"]
     lines = ["# Reliability", "",
@@ -124,6 +136,9 @@ def write(path, s, v, f, hostile_summary):
              f"{'identical, bit for bit,' if s['threads']['identical_to_one_thread'] else 'DIFFERENT'} to one thread "
              f"({s['threads']['seconds_one_thread']:.2f} s alone, {s['threads']['seconds_threaded']:.2f} s threaded "
              f"on {s['threads']['cores']} cores).",
+             "- **Thread safety in CI**: `tests/test_threads.c` runs both FMUs and the library's batch, built with "
+             "ThreadSanitizer, in parallel threads, in every configuration whose code differs, each run against the "
+             "same run alone, bit for bit; a data race fails it (ctest `c_threads`).",
              f"- **{steps['internal_steps']:,} internal steps** of a striker bouncing under gravity "
              f"({steps['impacts']} impacts, {steps['simulated_seconds']:.1f} s simulated, {steps['wall_seconds']:.1f} s "
              f"of CPU): resident memory sampled every tenth of the run "
@@ -149,8 +164,9 @@ def write(path, s, v, f, hostile_summary):
               "any value reference with raw doubles — NaN, Inf, denormals —, initialization, steps from any time, "
               "states got, set, serialized and deserialized from mutated or truncated bytes, reset, terminate, free) "
               "and checks after each call that the status is one the standard allows and that readable outputs "
-              "are finite with F >= 0. CI fuzzes for 60 s (`scripts/test`); every input that ever broke it is "
-              "replayed in every build (`tests/fuzz_regressions/`).", "",
+              "are finite with F >= 0; `tests/fuzz_fmi3.c` does the same for FMI 3.0. Every input that ever broke "
+              "them is replayed in every build (`tests/fuzz_regressions/`).", "",
+              FUZZ_BUDGET, "",
               f"This run: **{f['executions']:,} executions** ({f['per_second']:,} per second, libFuzzer with ASan and "
               f"UBSan), {f['edges']} coverage edges, a corpus of {f['corpus']} inputs, "
               f"{'a CRASH (see build-fuzz/fuzz-crash-*)' if f['crashed'] else 'no crash'}. Line coverage of the FMU's "
