@@ -51,11 +51,11 @@ static uint32_t reference(program *p)
     return known[byte(p) % (sizeof known / sizeof known[0])];
 }
 
-/* What one input may make the FMU compute, so that the fuzzer runs
- * thousands of inputs a second (long runs are the soak's): internal steps in
- * all its DoSteps, and the terms of a full G1 history's sums, where every
- * internal step sums the whole history so far (a run of N steps, N^2 / 2
- * terms). */
+/* What one input may make the FMU compute, so that no input runs long and
+ * the fuzzer keeps the rate its tests ask (tests/fuzz_rate.py; long runs are
+ * the soak's): internal steps in all its DoSteps, and the terms of a full
+ * G1 history's sums, where every internal step sums the whole history so
+ * far (a run of N steps, N^2 / 2 terms). */
 #define BUDGET_STEPS 1024.0
 #define BUDGET_TERMS 262144.0
 
