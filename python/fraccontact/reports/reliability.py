@@ -21,10 +21,11 @@ from .. import atomic
 from . import BAR, make_folder, source_tree
 
 ROOT = source_tree()
-FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
-               "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
-    f"fmu_src/model/{name}.c" for name in ("parameters", "method", "resolution", "model", "stage", "sdirk2",
-                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central")]
+FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",
+               "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
+    f"fmu_src/model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
+                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central",
+                                           "passivity")]
 
 
 def sh(*args, **kw):
