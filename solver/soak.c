@@ -1,6 +1,8 @@
 /* fraccontact-soak: scale and endurance of the FMU (python/fraccontact/reports/reliability.py
- * runs it for docs/reliability.md; not a test). Prints one JSON object.
- *   fraccontact-soak instances N      N instances alive at once, each through an impact
+ * runs it for docs/reliability.md, and
+ * tests/test_reliability_claims.py checks its memory per instance). Prints one JSON object.
+ *   fraccontact-soak instances N      N instances alive at once, each through an impact (and the
+ *                                     size of the contact model an instance holds)
  *   fraccontact-soak threads T        T threads stepping their own instances at once,
  *                                     compared bit for bit with one thread
  *   fraccontact-soak steps S          S internal steps of bouncing under gravity
@@ -102,8 +104,10 @@ static int instances(long n)
         }
     }
     printf("{\"instances\": %ld, \"rss_before_mib\": %.1f, \"rss_alive_mib\": %.1f, \"kib_per_instance\": %.2f, "
-           "\"seconds_for_all_impacts\": %.2f, \"sampled_differ_from_alone\": %s}\n",
-           n, before, alive, (alive - before) * 1024.0 / (double)n, wall_now() - t0, worst > 0 ? "true" : "false");
+           "\"seconds_for_all_impacts\": %.2f, \"sampled_differ_from_alone\": %s, \"bytes_contact_model\": %zu, "
+           "\"max_modes\": %d}\n",
+           n, before, alive, (alive - before) * 1024.0 / (double)n, wall_now() - t0, worst > 0 ? "true" : "false",
+           sizeof(contact_model), CONTACT_MAX_MODES);
     for (i = 0; i < n; i++)
         fmi2FreeInstance(x[i]);
     free(x);

@@ -79,13 +79,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fmi2FMUstate state[2] = {NULL, NULL};
     fmi2Byte blob[4096];
     size_t blob_size = 0;
+    budget spent = {0.0, 0.0};
     int steps = 0;
     while (more(&p, 1) && steps < 64) {
         uint8_t op = byte(&p);
         int k = op >> 7;                       /* which instance */
         fmi2Component x = c[k];
         fmi2ValueReference vr = 0;
-        fmi2Real r = 0.0, t = 0.0, now = 0.0;
+        fmi2Real r = 0.0, t = 0.0, now = 0.0, dt = 0.0;
         fmi2Integer n = 0, order = 1;
         fmi2Boolean b = fmi2False;
         fmi2Status s;
@@ -134,24 +135,22 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (x)
                 check_outputs(x);
             break;
-        case 11: /* a step from the last successful time, or from anywhere */
+        case 11: /* a step from the last successful time, or from anywhere, as the budget allows */
             if (!x)
                 break;
             r = value(&p);
-            /* Keep each input quick (long runs are the soak's): at most 1e-4 s
-             * and 1e4 internal steps a call. */
             vr = 10;
-            if (checked(fmi2GetReal(x, &vr, 1, &t)) == fmi2OK && r > 1e4 * t)
-                r = 1e4 * t;
-            if (r > 1e-4)
-                r = 1e-4;
-            /* ... and a full G1 history at most 3e4 steps a run (O(N^2) in all) */
-            vr = 10;
-            if (full_history(x) && checked(fmi2GetReal(x, &vr, 1, &t)) == fmi2OK
-                && checked(fmi2GetRealStatus(x, fmi2LastSuccessfulTime, &now)) == fmi2OK && (now + r) / t > 3e4)
-                break;
-            if (checked(fmi2GetRealStatus(x, fmi2LastSuccessfulTime, &t)) != fmi2OK || (byte(&p) & 1))
+            if (checked(fmi2GetReal(x, &vr, 1, &dt)) != fmi2OK)
+                dt = 0.0;
+            dt = internal_step(dt);
+            r = affordable(&spent, r, dt);
+            if (checked(fmi2GetRealStatus(x, fmi2LastSuccessfulTime, &now)) != fmi2OK)
+                now = 0.0;
+            t = now;
+            if (byte(&p) & 1)
                 t = value(&p);
+            if (!pay(&spent, r, dt, now / dt, full_history(x)))
+                break;
             steps++;
             s = checked(fmi2DoStep(x, t, r, fmi2True));
             if (s == fmi2OK)

@@ -131,26 +131,23 @@ static double model_time(fmi3Instance x)
     return fmi3GetFloat64(x, &time, 1, &t, 1) == fmi3OK ? t : 0.0;
 }
 
-/* A step of H from the model's time, or from anywhere; bounded as
- * fuzz_fmi2.c bounds it (1e-4 s and 1e4 internal steps a call, 3e4 steps
- * a run of a full G1 history), then checked. */
-static void do_step(fmi3Instance x, instance_info *info, program *p)
+/* A step of H from the model's time, or from anywhere, as the input's
+ * budget allows (fuzz_program.h), then checked. */
+static void do_step(fmi3Instance x, instance_info *info, budget *spent, program *p)
 {
     const fmi3ValueReference dt_vr = 10;
-    fmi3Float64 H = value(p), dt = 0.0, t = model_time(x), last = -1.0;
+    fmi3Float64 H = value(p), dt = 0.0, now = model_time(x), t = now, last = -1.0;
     fmi3Boolean event = fmi3True, terminate = fmi3True, early = fmi3True;
     fmi3Status s;
     snapshot before;
-    if (checked(fmi3GetFloat64(x, &dt_vr, 1, &dt, 1)) == fmi3OK) {
-        if (H > 1e4 * dt)
-            H = 1e4 * dt;
-        if (full_history(x) && (t + H) / dt > 3e4)
-            return;
-    }
-    if (H > 1e-4)
-        H = 1e-4;
+    if (checked(fmi3GetFloat64(x, &dt_vr, 1, &dt, 1)) != fmi3OK)
+        dt = 0.0;
+    dt = internal_step(dt);
+    H = affordable(spent, H, dt);
     if (byte(p) & 1)
         t = value(p);
+    if (!pay(spent, H, dt, now / dt, full_history(x)))
+        return;
     before = take(x);
     info->step_start = t;
     info->step_end = t + H;
@@ -290,6 +287,7 @@ typedef struct {
     fmi3FMUState state[2];
     uint8_t blob[1 << 16];
     size_t blob_size;
+    budget spent;
 } world;
 
 static void instantiate(world *w, int k, program *p)
@@ -387,7 +385,7 @@ static void run(world *w, program *p)
         case 13:
             if (x) {
                 steps++;
-                do_step(x, &w->info[k], p);
+                do_step(x, &w->info[k], &w->spent, p);
             }
             break;
         case 14:

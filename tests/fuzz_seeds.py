@@ -126,3 +126,18 @@ SEEDS3 = {
 for name, program in SEEDS3.items():
     (HERE / "fuzz_corpus" / f"{name}.bin").write_bytes(program)
 print(f"wrote {len(SEEDS3)} FMI 3.0 seeds to {HERE / 'fuzz_corpus'}")
+
+# --- Regressions (tests/fuzz_regressions/): inputs that ran for a minute
+# before the harnesses bounded each input's work (fuzz_program.h), a
+# springpot's full G1 history run again and again from a state at its start.
+FULL_HISTORY_1E8 = bytes([SET_INT, REF[33], 2, SET_INT, REF[34], 1, SET_REAL, REF[10]]) + raw(1e-8)
+F3_FULL_HISTORY_1E8 = bytes([F3_SET_INT, REF[33], 2, F3_SET_INT, REF[34], 1, F3_SET_REAL, REF[10]]) + raw(1e-8)
+REGRESSIONS = {
+    "slow-full-history-run-again": start(params=FULL_HISTORY_1E8) + bytes([GET_STATE])
+    + (steps(3) + bytes([SET_STATE, 0])) * 21,
+    "fmi3-slow-full-history-run-again": f3_start(params=F3_FULL_HISTORY_1E8) + bytes([F3_GET_STATE])
+    + (f3_steps(3) + bytes([F3_SET_STATE, 0])) * 21,
+}
+for name, program in REGRESSIONS.items():
+    (HERE / "fuzz_regressions" / f"{name}.bin").write_bytes(program)
+print(f"wrote {len(REGRESSIONS)} regression inputs to {HERE / 'fuzz_regressions'}")

@@ -21,10 +21,11 @@ from .. import atomic
 from . import BAR, make_folder, source_tree
 
 ROOT = source_tree()
-FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_vars.c",
-               "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
-    f"fmu_src/model/{name}.c" for name in ("parameters", "method", "resolution", "model", "stage", "sdirk2",
-                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central")]
+FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",
+               "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
+    f"fmu_src/model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
+                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central",
+                                           "passivity")]
 
 
 def sh(*args, **kw):
@@ -105,6 +106,18 @@ def mutation_section(path):
     return text[start:end + len(MUTATION_END)] + "\n" if 0 <= start < end else ""
 
 
+# What CI's fuzzing runs, from the harnesses' budget (tests/fuzz_program.h) and
+# the fuzz tests' floors (CMakeLists.txt, add_fmi_fuzzer; tests/fuzz_rate.py):
+# tests/test_reliability_claims.py reads both.
+FUZZ_BUDGET = ("Each input's work is bounded (`tests/fuzz_program.h`): at most 1,024 internal steps in all its "
+               "steps and 262,144 terms of a full G1 history's sums, so that no input runs long (`fuzz_replay "
+               "-timeout=1` fails one that takes a second of CPU, in every build). CI fuzzes each harness for 30 s "
+               "with ASan and UBSan, then 10 s without sanitizers (`scripts/test`, FUZZ_SECONDS = 60); the fuzz "
+               "tests fail below 250 inputs per second of CPU with the sanitizers and 1,000 without "
+               "(`tests/fuzz_rate.py`, which prints each run's count): on an idle core, CI's fuzzing runs at least "
+               "17,500 inputs a harness.")
+
+
 def write(path, s, v, f, hostile_summary):
     steps = s["steps"]
     lines = ["# Reliability", "",
@@ -113,7 +126,10 @@ def write(path, s, v, f, hostile_summary):
              "## Scale, threads, soak", "",
              f"- **{s['instances']['instances']:,} instances alive at once** in one process: resident memory "
              f"{s['instances']['rss_before_mib']:.1f} MiB before, {s['instances']['rss_alive_mib']:.1f} MiB with all "
-             f"alive ({s['instances']['kib_per_instance']:.2f} KiB per instance); each then run through an impact "
+             f"alive ({s['instances']['kib_per_instance']:.1f} KiB per instance: an instance holds the contact model "
+             f"twice, its state and its prediction of the next communication step, "
+             f"{s['instances']['bytes_contact_model']:,} B each, most of it the compressed memory's arrays for "
+             f"{s['instances']['max_modes']} modes, whatever the damper); each then run through an impact "
              f"(dt_max = 1e-6 s), {s['instances']['seconds_for_all_impacts']:.2f} s for all; every 997th compared "
              f"with the same instance alone: {'identical' if not s['instances']['sampled_differ_from_alone'] else 'DIFFERENT'}.",
              f"- **{s['threads']['threads']} threads** stepping {s['threads']['instances']} distinct instances at "
@@ -121,6 +137,9 @@ def write(path, s, v, f, hostile_summary):
              f"{'identical, bit for bit,' if s['threads']['identical_to_one_thread'] else 'DIFFERENT'} to one thread "
              f"({s['threads']['seconds_one_thread']:.2f} s alone, {s['threads']['seconds_threaded']:.2f} s threaded "
              f"on {s['threads']['cores']} cores).",
+             "- **Thread safety in CI**: `tests/test_threads.c` runs both FMUs and the library's batch, built with "
+             "ThreadSanitizer, in parallel threads, in every configuration whose code differs, each run against the "
+             "same run alone, bit for bit; a data race fails it (ctest `c_threads`).",
              f"- **{steps['internal_steps']:,} internal steps** of a striker bouncing under gravity "
              f"({steps['impacts']} impacts, {steps['simulated_seconds']:.1f} s simulated, {steps['wall_seconds']:.1f} s "
              f"of CPU): resident memory sampled every tenth of the run "
@@ -146,8 +165,9 @@ def write(path, s, v, f, hostile_summary):
               "any value reference with raw doubles — NaN, Inf, denormals —, initialization, steps from any time, "
               "states got, set, serialized and deserialized from mutated or truncated bytes, reset, terminate, free) "
               "and checks after each call that the status is one the standard allows and that readable outputs "
-              "are finite with F >= 0. CI fuzzes for 60 s (`scripts/test`); every input that ever broke it is "
-              "replayed in every build (`tests/fuzz_regressions/`).", "",
+              "are finite with F >= 0; `tests/fuzz_fmi3.c` does the same for FMI 3.0. Every input that ever broke "
+              "them is replayed in every build (`tests/fuzz_regressions/`).", "",
+              FUZZ_BUDGET, "",
               f"This run: **{f['executions']:,} executions** ({f['per_second']:,} per second, libFuzzer with ASan and "
               f"UBSan), {f['edges']} coverage edges, a corpus of {f['corpus']} inputs, "
               f"{'a CRASH (see build-fuzz/fuzz-crash-*)' if f['crashed'] else 'no crash'}. Line coverage of the FMU's "

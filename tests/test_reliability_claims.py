@@ -1,0 +1,68 @@
+"""Figures of docs/reliability.md that every build measures again, not only
+its report (scripts/report reliability): each test finds its sentence, reads
+the figures as written there, and measures them on this build. A figure
+that drifts, or a sentence reworded without its test, fails here."""
+
+import json
+import os
+import pathlib
+import re
+import subprocess
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+PAGE = " ".join((ROOT / "docs" / "reliability.md").read_text().split())
+SOAK = os.environ.get("FRACCONTACT_SOAK", str(ROOT / "build" / "fraccontact-soak"))
+
+
+def claim(pattern):
+    m = re.search(pattern, PAGE)
+    assert m, f"docs/reliability.md no longer says {pattern!r}: update the sentence's test with it"
+    return m.groups()
+
+
+@pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                    reason="AddressSanitizer's redzones and shadow memory are resident memory too")
+def test_the_memory_per_instance_is_what_an_instance_holds():
+    """The resident memory per FMU instance, as fraccontact-soak measures it
+    with that many instances alive, rounded to the page's digits; and the
+    page's account of it: the contact model twice (its size and its modes
+    read from the build), with less than a page of memory besides."""
+    count, kib, model, modes = claim(r"\*\*([\d,]+) instances alive at once\*\*.*? \(([\d.]+) KiB per instance: "
+                                     r"an instance holds the contact model twice, its state and its prediction of "
+                                     r"the next communication step, ([\d,]+) B each, most of it the compressed "
+                                     r"memory's arrays for (\d+) modes, whatever the damper\)")
+    done = subprocess.run([SOAK, "instances", count.replace(",", "")], capture_output=True, text=True, check=True)
+    measured = json.loads(done.stdout)
+    assert (measured["bytes_contact_model"], measured["max_modes"]) == (int(model.replace(",", "")), int(modes))
+    decimals = len(kib.partition(".")[2])
+    assert f"{measured['kib_per_instance']:.{decimals}f}" == kib, f"measured {measured['kib_per_instance']} KiB"
+    per_instance = measured["kib_per_instance"] * 1024
+    assert 2 * measured["bytes_contact_model"] <= per_instance < 2 * measured["bytes_contact_model"] + 4096
+
+
+def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
+    """The budget of an input as the harnesses define it, the seconds and
+    the floors of the fuzz tests as CMake and scripts/test set them, and the
+    count CI runs at least, which follows from them."""
+    steps, terms, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
+        r"Each input's work is bounded \(`tests/fuzz_program.h`\): at most ([\d,]+) internal steps in all its steps "
+        r"and ([\d,]+) terms of a full G1 history's sums, so that no input runs long \(`fuzz_replay -timeout=(\d+)` "
+        r"fails one that takes a second of CPU, in every build\)\. CI fuzzes each harness for (\d+) s with ASan and "
+        r"UBSan, then (\d+) s without sanitizers \(`scripts/test`, FUZZ_SECONDS = 60\); the fuzz tests fail below "
+        r"([\d,]+) inputs per second of CPU with the sanitizers and ([\d,]+) without \(`tests/fuzz_rate.py`, which "
+        r"prints each run's count\): on an idle core, CI's fuzzing runs at least ([\d,]+) inputs a harness\.")
+    n = lambda text: int(text.replace(",", ""))
+    program = (ROOT / "tests" / "fuzz_program.h").read_text()
+    assert float(re.search(r"#define BUDGET_STEPS ([\d.]+)", program).group(1)) == n(steps)
+    assert float(re.search(r"#define BUDGET_TERMS ([\d.]+)", program).group(1)) == n(terms)
+    cmake = (ROOT / "CMakeLists.txt").read_text()
+    fuzzer = cmake[cmake.index("function(add_fmi_fuzzer"):cmake.index("endfunction()", cmake.index("function(add_fmi_fuzzer"))]
+    assert re.findall(r"set\(floor (\d+)\)", fuzzer) == [sanitized_floor.replace(",", ""), plain_floor.replace(",", "")]
+    assert f"-timeout={timeout}" in fuzzer
+    assert re.findall(r"fuzz_replay(?:_fmi3)? -timeout=(\d+)", cmake) == [timeout, timeout]
+    assert re.search(r'FRACCONTACT_FUZZ_PLAIN_SECONDS (\d+) CACHE', cmake).group(1) == plain
+    script = (ROOT / "scripts" / "test").read_text()
+    assert '-DFRACCONTACT_FUZZ_SECONDS="$(( ${FUZZ_SECONDS:-60} / 2 ))"' in script and n(sanitized) == 60 // 2
+    assert n(at_least) == n(sanitized) * n(sanitized_floor) + n(plain) * n(plain_floor)
