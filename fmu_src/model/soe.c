@@ -50,10 +50,11 @@ static void fast_tail(double alpha, double lg_alpha, double x, double *value, do
  * bracket in ln x (a step leaving it bisects it), to rounding. */
 static double decreasing_below(log_bound f, double alpha, double target, double lo, double hi)
 {
-    /* ln Gamma(alpha) as log(tgamma(alpha)), Gamma being positive for
-     * alpha > 0: lgamma would write the global signgam, a data race between
-     * threads building kernels at once. */
-    const double lg_alpha = log(tgamma(alpha)), goal = log(target);
+    /* ln Gamma(alpha) from Gamma(alpha) = Gamma(1 + alpha) / alpha: lgamma
+     * would write the global signgam, a data race between threads building
+     * kernels at once, and tgamma(alpha) itself overflows for alpha below
+     * 1 / DBL_MAX, where Gamma(1 + alpha) is still near 1. */
+    const double lg_alpha = log(tgamma(1.0 + alpha)) - log(alpha), goal = log(target);
     double a = log(lo), b = log(hi), s, value, slope;
     int i;
     f(alpha, lg_alpha, lo, &value, &slope);
