@@ -12,11 +12,13 @@ The library: $FRACCONTACT_OMSIMULATOR, else the one installed beside the
 OMSimulator executable on PATH (<prefix>/bin/OMSimulator, <prefix>/lib/).
 """
 
+import contextlib
 import ctypes
 import functools
 import os
 import pathlib
 import shutil
+import sys
 import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
@@ -58,10 +60,32 @@ def _collect(kind, message):
         _messages.append(message.decode(errors="replace"))
 
 
+@contextlib.contextmanager
+def quiet():
+    """OMSimulator's log muted: it writes every message to stdout or stderr
+    (a command's output, its JSON, is stdout), and its count of warnings and
+    errors at exit, which are reset here; its errors reach the exceptions
+    call() raises."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        yield
+    finally:
+        load().oms_setLogFile(b"")  # resets the counts
+        ctypes.CDLL(None).fflush(None)  # what C++ streams left in C's buffers goes to /dev/null
+        for fd, copy in zip((1, 2), saved):
+            os.dup2(copy, fd)
+            os.close(copy)
+        os.close(null)
+
+
 @functools.lru_cache(maxsize=None)
 def load():
-    """The library, its functions typed, its log silenced (it writes to
-    stdout) and its errors collected."""
+    """The library, its functions typed and its errors collected."""
     path = library_path()
     if path is None:
         raise RuntimeError(f"OMSimulator is not installed: put OMSimulator on PATH or set {VARIABLE} to its "
@@ -81,13 +105,14 @@ def load():
     lib.oms_getVersion.argtypes, lib.oms_getVersion.restype = [], text
     lib.oms_setLoggingCallback.argtypes, lib.oms_setLoggingCallback.restype = [type(_collect)], None
     lib.oms_setLoggingCallback(_collect)
-    call(lib, "oms_setLogFile", os.devnull.encode())
     return lib
 
 
 def version():
     """The build that runs, as OMSimulator names itself (its git description)."""
-    return load().oms_getVersion().decode()
+    lib = load()
+    with quiet():
+        return lib.oms_getVersion().decode()
 
 
 def call(lib, name, *args):
@@ -113,7 +138,7 @@ def simulate(ssp, H, t, start, recorded):
     lib = load()
     trace = {name: np.empty(len(t)) for name in recorded}
     value = ctypes.c_double()
-    with tempfile.TemporaryDirectory(prefix="fraccontact-omsimulator-") as folder:
+    with quiet(), tempfile.TemporaryDirectory(prefix="fraccontact-omsimulator-") as folder:
         call(lib, "oms_setTempDirectory", folder.encode())  # where it unpacks the SSP
         cref = ctypes.c_char_p()
         call(lib, "oms_importFile", str(ssp).encode(), ctypes.byref(cref))

@@ -142,7 +142,7 @@ def omsimulator_note():
     """The OMSimulator column's bullet, where it ran."""
     if "omsimulator" not in MASTERS:
         return []
-    return [f"- omsimulator: OMSimulator {omsimulator.version()}, built from its sources (docs/ssp.md), through its "
+    return [f"- omsimulator: {omsimulator.version()}, built from its sources (docs/ssp.md), through its "
             "C API (fraccontact.omsimulator): its fixed-step master oms-ma, which the SSDs' OpenModelica "
             "annotation names, applies the SSV bindings itself and steps every FMU from the last communication "
             "point, from the outputs' initial values, as libcosim does: the two give one trace "
