@@ -142,11 +142,14 @@ def omsimulator_note():
     """The OMSimulator column's bullet, where it ran."""
     if "omsimulator" not in MASTERS:
         return []
-    return [f"- omsimulator: {omsimulator.version()}, built from its sources (docs/ssp.md), through its "
-            "C API (fraccontact.omsimulator): its fixed-step master oms-ma, which the SSDs' OpenModelica "
-            "annotation names, applies the SSV bindings itself and steps every FMU from the last communication "
-            "point, from the outputs' initial values, as libcosim does: the two give one trace "
-            "(tests/test_omsimulator.py)."]
+    return [f"- omsimulator: {omsimulator.version()}, built from its sources (docs/ssp.md), through its C API "
+            "(fraccontact.omsimulator). Its fixed-step master oms-ma, which the SSDs' OpenModelica annotation "
+            "names, applies the SSV bindings itself and steps every FMU from the last communication point, from the "
+            "outputs' initial values, as libcosim does, but sets the inputs in the order of the FMUs' declared "
+            "dependencies: the panel's a, which depends on its input F2 (the skin's force), reaches the hard "
+            "contact after F2 is set, holding the skin's force of the step to come where libcosim's holds the "
+            "last step's. The bumper, without such a chain, is libcosim's trace to rounding; the headform is "
+            "until the panel reaches the hard point (tests/test_omsimulator.py)."]
 
 
 def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_conv, bumper_conv, curves):
