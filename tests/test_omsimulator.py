@@ -116,10 +116,12 @@ def test_omsimulator_reads_an_output_after_the_input_it_depends_on(traces):
 
 # The figures against the reference on the same grid at H = 1e-5 (docs/scenes.md):
 # the bumper's are libcosim's (F_peak 2.4e-7, crush 2.4e-7, restitution
-# 1.7e-6 seen); the headform's HIC15 8.5e-7 (libcosim's 2.6e-4, whose hard
-# contact takes a one step old), peak g 1.3e-4, panel deflection 6.6e-6,
-# restitution 5.8e-6. The bounds: about ten times each.
-TOLERANCES = {"headform": {"HIC15": 1e-5, "peak_g": 1e-3, "panel_deflection": 1e-4, "restitution": 1e-4},
+# 1.7e-6 seen); the headform's peak g 1.3e-4, panel deflection 6.5e-6,
+# restitution 1.8e-5, and HIC15 -8.4e-7 by chance: its error changes sign
+# between H = 1e-5 and 5e-6 (-2.4e-4 at 2e-5, +6.4e-6 at 5e-6). The bounds:
+# about ten times each; HIC15's ten times the finer step's error, below
+# libcosim's 2.6e-4 (whose hard contact takes the panel's a of the last step).
+TOLERANCES = {"headform": {"HIC15": 1e-4, "peak_g": 1e-3, "panel_deflection": 1e-4, "restitution": 2e-4},
               "bumper": {"F_peak": 3e-6, "crush": 3e-6, "restitution": 2e-5}}
 
 
