@@ -1,6 +1,7 @@
 """The drop test as an SSP file (build/drop_test.ssp, made by CMake from ssp/):
 the striker and the contact FMU wired for the predictive coupling (F_avg_next),
-run by two independent SSP importers, fmpy and libcosim (libcosimpy).
+run by two independent SSP importers, fmpy and libcosim (libcosimpy), and by
+OMSimulator where it is installed (fraccontact.omsimulator).
 
 Both step every FMU from the values of the last communication point (Jacobi),
 so the results are those of fraccontact.cosim's Jacobi order, predictive
@@ -79,3 +80,12 @@ def run_libcosim(ssp, H, t_end=T_END):
     names = ("scene", "law", "coupling")
     applied = dict(zip(names, observer.last_integer_values(contact, [vr["contact"][n] for n in names])))
     return dict(summary(F_peak, E_diss, v_end), applied=applied)
+
+
+def run_omsimulator(ssp, H, t_end=T_END):
+    """The scene in OMSimulator's fixed-step master (it applies the parameter
+    bindings itself) at step H instead of the SSD's."""
+    from .omsimulator import simulate
+    from .scenes.masters import grid
+    trace = simulate(ssp, H, grid(H, t_end), {}, ("contact.F_peak", "contact.E_diss", "striker.v"))
+    return summary(trace["contact.F_peak"][-1], trace["contact.E_diss"][-1], trace["striker.v"][-1])

@@ -1,6 +1,7 @@
 """The crash scenes as co-simulations (issue 25): build/headform.ssp and
 build/bumper.ssp in fmpy's SSP master, libcosim and a container FMU
-(fmu-manipulation-toolbox, in its parallel and its sequential mode) against
+(fmu-manipulation-toolbox, in its parallel and its sequential mode), and
+OMSimulator where it is installed (its column names the build), against
 their monolithic reference
 (fraccontact.scenes.chain, scipy), the convergence in H, the HIC15 against
 the clearance, and the figures beside the published ones. Writes
@@ -14,11 +15,11 @@ Regenerate: scripts/report scenes   (a few minutes)
 import numpy as np
 from tqdm import tqdm
 
-from .. import atomic, crash, reports
+from .. import atomic, crash, omsimulator, reports
 from ..scenes import headform, masters, systems
 from ..scenes.parameters import ADULT, CHILD, HIC_LIMITS, SPEEDS
 
-MASTERS = ("fmpy", "libcosim", "container", "container-gs")
+MASTERS = ("fmpy", "libcosim", "container", "container-gs") + (("omsimulator",) if omsimulator.available() else ())
 STEPS = (4e-5, 2e-5, 1e-5, 5e-6)
 CLEARANCES = np.arange(0.040, 0.0801, 0.0025)
 ENERGY_FIGURES = (("energy_error", "{:.2e}"), ("energy_first", "{:.2e}"), ("energy_max", "{:.2e}"))
@@ -33,7 +34,7 @@ def side_by_side(scene, rows, options=None):
     """The masters' figures beside the reference's, and each one's relative error."""
     ref = masters.figures(masters.run(scene, "reference", options=options), scene, options)
     runs = {m: masters.figures(masters.run(scene, m, options=options), scene, options) for m in MASTERS}
-    out = ["| figure | reference | " + " | ".join(MASTERS) + " |", "|---|---|" + "---|" * len(MASTERS)]
+    out = ["| figure | reference | " + " | ".join(map(label, MASTERS)) + " |", "|---|---|" + "---|" * len(MASTERS)]
     for name, fmt in rows:
         cells = []
         for m in MASTERS:
@@ -42,6 +43,11 @@ def side_by_side(scene, rows, options=None):
             cells.append(fmt.format(value) + error)
         out.append(f"| {name} | {fmt.format(ref[name])} | " + " | ".join(cells) + " |")
     return out, ref, runs
+
+
+def label(master):
+    """A master's column: its name, and OMSimulator's the build that ran."""
+    return f"omsimulator ({omsimulator.version()})" if master == "omsimulator" else master
 
 
 def convergence(scene, names, bar):
@@ -132,6 +138,20 @@ def crossing(gaps, hic, limit):
     return float("nan")
 
 
+def omsimulator_note():
+    """The OMSimulator column's bullet, where it ran."""
+    if "omsimulator" not in MASTERS:
+        return []
+    return [f"- omsimulator: {omsimulator.version()}, built from its sources (docs/ssp.md), through its C API "
+            "(fraccontact.omsimulator). Its fixed-step master oms-ma, which the SSDs' OpenModelica annotation "
+            "names, applies the SSV bindings itself and steps every FMU from the last communication point, from the "
+            "outputs' initial values, as libcosim does, but sets the inputs in the order of the FMUs' declared "
+            "dependencies: the panel's a, which depends on its input F2 (the skin's force), reaches the hard "
+            "contact after F2 is set, holding the skin's force of the step to come where libcosim's holds the "
+            "last step's. The bumper, without such a chain, is libcosim's trace to rounding; the headform is "
+            "until the panel reaches the hard point (tests/test_omsimulator.py)."]
+
+
 def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_conv, bumper_conv, curves):
     k = systems.CLEARANCE
     loan = bumper_runs["libcosim"]["energy_first"]
@@ -176,7 +196,8 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_con
         "the contact that strikes them) and returns F_avg_next (coupling = 2, for the Jacobi masters), -F on "
         "its striker's input F and +F on its second body's F2.",
         "",
-        "Run one: `fraccontact scene headform --master fmpy|libcosim|container|container-gs|reference [--H ...] "
+        "Run one: `fraccontact scene headform --master fmpy|libcosim|container|container-gs|omsimulator|reference "
+        "[--H ...] "
         "[--headform child] [--gap0 ...]`, `fraccontact scene bumper [--v ...]`.",
         "",
         "**Recommended step: H = 1e-5 s** (the SSDs' step). The masters run the SSPs as they are, with "
@@ -199,6 +220,7 @@ def document(head_rows, head_ref, bumper_rows, bumper_ref, bumper_runs, head_con
         "(fmu_manipulation_toolbox.container.builder, check_sequential_order): Gauss-Seidel. The runner puts "
         "the contacts first, sets their coupling = 1 and feeds the bodies F_avg in place of the SSD's F_avg_next "
         "(fraccontact.scenes.container.gauss_seidel; docs/coupling.md).",
+        *omsimulator_note(),
         "",
         "## Headform on a bonnet: masters side by side",
         "",

@@ -34,7 +34,8 @@ def parser(prog=None):
     p = OneLineParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("name", choices=SCENES, metavar="NAME", help="headform | bumper")
     p.add_argument("--master", choices=MASTERS, default="fmpy",
-                   help="fmpy (default) | libcosim | container | container-gs (its sequential mode) | reference")
+                   help="fmpy (default) | libcosim | container | container-gs (its sequential mode) | omsimulator "
+                        "(where installed, docs/ssp.md) | reference")
     p.add_argument("--H", type=positive, help=f"communication step [s] (default {STEP['headform']:g}; at most {H_MAX:g})")
     p.add_argument("--t-end", type=positive, help="simulated time [s] (default: headform "
                    f"{T_END['headform']:g}, bumper {T_END['bumper']:g})")

@@ -19,6 +19,9 @@ Masters (each but container-gs steps every FMU from the last communication point
   container-gs  the same container in the toolbox's sequential mode: the
              contacts step first, the bodies then with their force
              (Gauss-Seidel, coupling = 1, F_avg).
+  omsimulator  OMSimulator's fixed-step master (fraccontact.omsimulator), where
+             it is installed; it applies the SSV bindings and passes the
+             outputs' initial values to the inputs.
   reference  the scene's Chain (scenes.chain) solved monolithically by scipy.
 """
 
@@ -34,7 +37,7 @@ from .chain import Contact
 from .parameters import ADULT, CHILD, SPEEDS, Bonnet, Bumper
 from .systems import CLEARANCE, RECORDED, STEP, T_END, VALUES
 
-MASTERS = ("fmpy", "libcosim", "container", "container-gs", "reference")
+MASTERS = ("fmpy", "libcosim", "container", "container-gs", "omsimulator", "reference")
 HEADFORMS = {"adult": ADULT, "child": CHILD}
 # The reference's tolerance: far below the co-simulations' errors.
 RTOL = 1e-10
@@ -82,7 +85,7 @@ def run(scene, master, H=None, t_end=None, options=None):
     if master == "reference":
         return reference(scene, H, t_end, options)
     runner = {"fmpy": run_fmpy, "libcosim": run_libcosim, "container": run_container,
-              "container-gs": run_container_gs}[master]
+              "container-gs": run_container_gs, "omsimulator": run_omsimulator}[master]
     return runner(scene, H, t_end, values(scene, options))
 
 
@@ -166,6 +169,11 @@ def run_container(scene, H, t_end, start, sequential=False):
 
 def run_container_gs(scene, H, t_end, start):
     return run_container(scene, H, t_end, start, sequential=True)
+
+
+def run_omsimulator(scene, H, t_end, start):
+    from ..omsimulator import simulate
+    return simulate(ssp_path(scene), H, grid(H, t_end), start, RECORDED[scene])
 
 
 def reference(scene, H, t_end, options=None):

@@ -1,9 +1,10 @@
 """The scenes as co-simulations of FMUs this project builds: the components
 of build/headform.ssp and build/bumper.ssp (their SSDs are ssp/headform.ssd
 and ssp/bumper.ssd) and each component's parameter values, taken from
-parameters.py. The build writes them as the SSPs' SSV files:
+parameters.py. The build writes them as the SSPs' SSV files, and the SSDs
+with the masters' step (@STEP@ in ssp/<scene>.ssd) set to STEP:
 
-    python -m fraccontact.scenes.systems OUTDIR     # OUTDIR/<scene>_<component>.ssv
+    python -m fraccontact.scenes.systems OUTDIR ssp     # OUTDIR/<scene>_<component>.ssv, OUTDIR/<scene>.ssd
 
 and the runners (masters.py) override them with a run's options.
 
@@ -96,7 +97,17 @@ def write_ssvs(folder):
             (folder / f"{name}.ssv").write_text(ssv(name, values))
 
 
+def write_ssds(sources, folder):
+    """Writes <scene>.ssd into folder: sources/<scene>.ssd with its masters' step, @STEP@, set to STEP[scene]."""
+    for scene in SCENES:
+        text = (pathlib.Path(sources) / f"{scene}.ssd").read_text()
+        (pathlib.Path(folder) / f"{scene}.ssd").write_text(text.replace("@STEP@", repr(STEP[scene])))
+
+
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description="Writes the scenes' SSV files.")
+    parser = argparse.ArgumentParser(description="Writes the scenes' SSV files and SSDs.")
     parser.add_argument("folder", type=pathlib.Path)
-    write_ssvs(parser.parse_args().folder)
+    parser.add_argument("sources", type=pathlib.Path, help="the folder of the SSDs' sources (ssp/)")
+    args = parser.parse_args()
+    write_ssvs(args.folder)
+    write_ssds(args.sources, args.folder)
