@@ -3,6 +3,7 @@ window at a time and their summaries folded on the workers (the
 statistics' among them), then the CSV when asked, the plot and
 sweep.json."""
 
+import contextlib
 import importlib
 import json
 import math
@@ -266,12 +267,18 @@ def raise_terminated(signum, frame):
     raise Terminated()
 
 
+@contextlib.contextmanager
 def terminated_raises():
-    """Makes SIGTERM raise Terminated, where a handler can be set (the main
-    thread); returns the previous handler, to be restored."""
+    """SIGTERM raises Terminated inside, where a handler can be set (the
+    main thread); the program's own handler is restored after."""
     if threading.current_thread() is not threading.main_thread():
-        return None
-    return signal.signal(signal.SIGTERM, raise_terminated)
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def main(argv=None, prog=None):
@@ -282,18 +289,15 @@ def main(argv=None, prog=None):
         parser.error(str(e))
     for why in unused:
         print(f"{parser.prog}: warning: {why}", file=sys.stderr)
-    previous = terminated_raises()
-    try:
-        return connected(parser, args, plan, size)
-    except Terminated:
-        print(f"{parser.prog}: terminated (SIGTERM); nothing written", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print(f"{parser.prog}: interrupted; nothing written", file=sys.stderr)
-        return 130
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    with terminated_raises():
+        try:
+            return connected(parser, args, plan, size)
+        except Terminated:
+            print(f"{parser.prog}: terminated (SIGTERM); nothing written", file=sys.stderr)
+            return 128 + signal.SIGTERM
+        except KeyboardInterrupt:
+            print(f"{parser.prog}: interrupted; nothing written", file=sys.stderr)
+            return 130
 
 
 def connected(parser, args, plan, size):
