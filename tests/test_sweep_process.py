@@ -1,6 +1,6 @@
 """The sweep and the process that runs it (issue 35, items 11 and 14): a
-program that calls sweep.main keeps its malloc settings and its SIGTERM
-handler, and the local worker processes close without an error in the
+program that calls sweep.main keeps its malloc settings, its SIGTERM
+handler and its log, and the local workers close without an error in the
 log. Each runs in a process of its own: malloc's settings are the
 process's, and the workers' log is its stderr."""
 
@@ -25,7 +25,7 @@ GRID = ["--vary", "c=3000,6080", "--set", "law=hertz"]
 # frees so large a chunk), and one the sweep's setting reached does not; the
 # probe checks that it tells the two apart, by setting it afterwards.
 CALLER = textwrap.dedent("""
-    import ctypes, json, signal, sys
+    import ctypes, json, logging, signal, sys
     from fraccontact import sweep
 
     class Mallinfo2(ctypes.Structure):
@@ -49,8 +49,11 @@ CALLER = textwrap.dedent("""
         pass
 
     signal.signal(signal.SIGTERM, handler)
+    log = logging.getLogger("distributed.worker")
+    filters = list(log.filters)
     status = sweep.main(sys.argv[1:])
-    seen = dict(status=status, handler_kept=signal.getsignal(signal.SIGTERM) is handler, mapped=mapped(24 << 20))
+    seen = dict(status=status, handler_kept=signal.getsignal(signal.SIGTERM) is handler,
+                log_kept=log.filters == filters, mapped=mapped(24 << 20))
     libc.mallopt(-3, 32 << 20)  # M_MMAP_THRESHOLD, as the sweep of 26f430c set it in this process
     seen["mapped_after_mallopt"] = mapped(28 << 20)
     print(json.dumps(seen))
@@ -60,13 +63,14 @@ CALLER = textwrap.dedent("""
 def test_a_program_that_calls_the_sweep_keeps_its_malloc_and_its_sigterm_handler(tmp_path):
     """The local cluster of threads runs in the caller's process: the sweep
     sets neither malloc's thresholds there (26f430c did, with mallopt, for
-    the rest of the program) nor, once it returns, SIGTERM's handler."""
+    the rest of the program) nor, once it returns, SIGTERM's handler or a
+    filter on Dask's log."""
     done = subprocess.run([sys.executable, "-c", CALLER, *GRID, "--workers", "1", "--out", str(tmp_path / "out")],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     seen = json.loads(done.stdout.splitlines()[-1])
     # mapped_after_mallopt: the probe sees the sweep's setting where it is made
-    assert seen == dict(status=0, handler_kept=True, mapped=True, mapped_after_mallopt=False)
+    assert seen == dict(status=0, handler_kept=True, log_kept=True, mapped=True, mapped_after_mallopt=False)
 
 
 # The scheduler (in the sweep's process) answers each heartbeat 3 s late, so
@@ -97,11 +101,12 @@ LATE_HEARTBEATS = textwrap.dedent("""
 """)
 
 
-def test_worker_processes_close_without_an_error_during_a_heartbeat(tmp_path):
+@pytest.mark.parametrize("local", [["--processes", "--workers", "2"], ["--workers", "2"]],
+                         ids=["processes", "threads"])
+def test_workers_close_without_an_error_during_a_heartbeat(local, tmp_path):
     script = tmp_path / "late_heartbeats.py"
     script.write_text(LATE_HEARTBEATS)
-    out = tmp_path / "out"
-    done = subprocess.run([sys.executable, str(script), *GRID, "--processes", "--workers", "2", "--out", str(out)],
+    done = subprocess.run([sys.executable, str(script), *GRID, *local, "--out", str(tmp_path / "out")],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     assert json.loads(done.stdout.splitlines()[-1])["impacts"] == 2

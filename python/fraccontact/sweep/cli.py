@@ -47,16 +47,16 @@ def connect(args):
         # No dashboard; the scheduler's HTTP server (its metrics) on a free
         # port of the loopback, not on 8787, which another cluster may hold.
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
+        from . import workers
         with dask.config.set(QUIET):
-            if not args.processes:
+            if args.processes:
+                with dask.config.set(workers.environment()):
+                    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, **quiet)
+            else:
                 cluster = LocalCluster(n_workers=1, threads_per_worker=count, processes=False, **quiet)
-                return Client(cluster), cluster
-            from . import workers
-            with dask.config.set(workers.environment()):
-                cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, **quiet)
             client = Client(cluster)
-            client.register_plugin(workers.QuietClose())
-            return client, cluster
+        client.register_plugin(workers.QuietClose())
+        return client, cluster
     try:
         return Client(args.scheduler, timeout=options.CONNECT_TIMEOUT), None
     except ValueError as e:  # an address Dask cannot parse
@@ -245,7 +245,9 @@ def write(args, plan, staging, count, summary, statistics, counted):
 def close(client, cluster):
     client.close()
     if cluster:
+        from . import workers
         cluster.close()
+        workers.forget()
 
 
 def stop(client, cluster):
