@@ -8,6 +8,7 @@ one each. Item 3's limit of 1e6 impacts is gone with the columnar sweep
 import os
 import resource
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -308,3 +309,12 @@ def test_the_sweep_extra_installs_what_the_docs_read_the_partitions_with():
         extra = tomllib.load(f)["project"]["optional-dependencies"]["sweep"]
     for module in ("pyarrow.parquet.read_table", "pandas.read_parquet"):
         assert module in readme_sweep_section() and module.partition(".")[0] in extra, module
+
+
+def test_help_and_docs_state_the_exit_statuses_of_a_signal(capsys):
+    """128 + the signal, as a shell reports a process the signal ended
+    (tests/test_sweep_scale.py sends them)."""
+    interrupt, terminate = 128 + signal.SIGINT, 128 + signal.SIGTERM
+    assert f"(Ctrl-C: exit status {interrupt}; SIGTERM: {terminate}) leaves nothing" in help_text(capsys)
+    assert f"(Ctrl-C: exit status {interrupt}; SIGTERM, as `timeout` and batch systems send it: {terminate}) " \
+           "leaves nothing" in readme_sweep_section()
