@@ -92,8 +92,8 @@ calling sweep.main; the library's calls and the Parquet writes release
 Python's GIL; default: the CPUs), or --workers processes with --processes;
 or on any running Dask scheduler (--scheduler ADDRESS, refused when none
 answers there within 5 s), whose workers must import fraccontact (pip
-install '.[sweep]') and see --out (one machine, or a shared file system). A task
-whose worker dies runs again on another: the results are the same.
+install '.[sweep]') and see --out (one machine, or a shared file system).
+A task whose worker dies runs again on another: the results are the same.
 Every option is checked, and --out too, before the cluster starts. The wall
 time and the impacts per second count the Dask tasks alone, from the first
 given to the last finished (before, each worker has imported the package).
