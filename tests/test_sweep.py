@@ -87,6 +87,18 @@ def test_grid_results_are_the_library_results_in_order(grid):
     assert (grid / "sweep.png").stat().st_size > 10000
 
 
+def test_pandas_reads_the_partitions_as_the_docs_say(grid):
+    """docs/sweeps.md: pandas.read_parquet reads the partitions folder
+    whole, the rows in case order as the CSV (written apart, by pyarrow's
+    CSV writer) has them."""
+    import pandas
+    frame = pandas.read_parquet(grid / "sweep.parquet")
+    rows = read(grid / "sweep.csv")
+    assert list(frame.columns) == list(rows[0])
+    for key in ("height", "c", "F_peak", "eps"):
+        assert frame[key].tolist() == [float(r[key]) for r in rows], key
+
+
 def test_help_states_the_default_law_and_the_scatter():
     done = sweep_command("--help")
     assert done.returncode == 0, done.stderr

@@ -8,6 +8,7 @@ one each. Item 3's limit of 1e6 impacts is gone with the columnar sweep
 import os
 import resource
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -231,7 +232,8 @@ def test_a_step_doubles_cannot_resolve_is_refused(no_cluster, tmp_path, capsys):
     (["--monte-carlo", "5", "--scatter", "c=0.1", "--seed", "-1"], "--seed -1"),
     (["--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers 2 with --scheduler"),
     (["--workers", "100000"], "--workers 100000: a local cluster has 1 to"),
-    (["--batch", "-1"], "--batch -1"),
+    (["--batch", "-1"], "--batch -1: impacts per Dask task, >= 1"),
+    (["--batch", "0"], "--batch 0: impacts per Dask task, >= 1"),  # issue 35 item 14: 26f430c took it
     (["--vary", "c=1:inf:1"], "--vary c=1:inf:1: a grid's start, stop and step are finite"),
 ])
 def test_options_that_would_be_ignored_or_contradict_are_refused(args, message, no_cluster, tmp_path, capsys):
@@ -284,3 +286,35 @@ def test_an_unreachable_scheduler_is_refused_quickly(tmp_path, capsys, monkeypat
 def test_the_drift_the_readme_shows():
     """docs/sweeps.md's example of what adding doubles gives, beside the grid's 0.035 (test_grid_rule)."""
     assert repr(0.005 + 6 * 0.005) == "0.034999999999999996" and "0.034999999999999996" in readme_sweep_section()
+
+
+# ---------------------------------------------------------------- issue 35, item 20
+
+
+def test_help_and_docs_say_where_the_local_workers_run(capsys):
+    """The default cluster's threads run in the sweep's process (26f430c:
+    "in its own process" in the docs, "in this process" in --help)."""
+    where = "the process that runs the sweep (this command's, or that of a program calling"
+    assert f"threads in {where} sweep.main" in help_text(capsys)
+    assert f"with a thread per CPU, in {where} `sweep.main`)" in readme_sweep_section()
+    assert "in its own process" not in readme_sweep_section()
+
+
+def test_the_sweep_extra_installs_what_the_docs_read_the_partitions_with():
+    """docs/sweeps.md reads the partitions with pyarrow or pandas: pip
+    install '.[sweep]' installs both (26f430c: no pandas)."""
+    import tomllib
+    root = os.path.join(os.path.dirname(__file__), "..")
+    with open(os.path.join(root, "pyproject.toml"), "rb") as f:
+        extra = tomllib.load(f)["project"]["optional-dependencies"]["sweep"]
+    for module in ("pyarrow.parquet.read_table", "pandas.read_parquet"):
+        assert module in readme_sweep_section() and module.partition(".")[0] in extra, module
+
+
+def test_help_and_docs_state_the_exit_statuses_of_a_signal(capsys):
+    """128 + the signal, as a shell reports a process the signal ended
+    (tests/test_sweep_scale.py sends them)."""
+    interrupt, terminate = 128 + signal.SIGINT, 128 + signal.SIGTERM
+    assert f"(Ctrl-C: exit status {interrupt}; SIGTERM: {terminate}) leaves nothing" in help_text(capsys)
+    assert f"(Ctrl-C: exit status {interrupt}; SIGTERM, as `timeout` and batch systems send it: {terminate}) " \
+           "leaves nothing" in readme_sweep_section()

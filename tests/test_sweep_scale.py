@@ -452,6 +452,17 @@ def test_a_scheduler_and_a_worker_started_as_processes(cluster, local_runs, tmp_
         json.loads((local_runs[0] / "sweep.json").read_text())["statistics"]
 
 
+def test_a_relative_out_is_the_sweeps_for_the_workers_too(cluster, tmp_path, monkeypatch):
+    """--out taken from the sweep's working folder, which is not the
+    workers' (they started before the chdir): the workers write there
+    (26f430c: refused, "the workers ... do not see it")."""
+    remote = cluster(1)
+    monkeypatch.chdir(tmp_path)
+    assert sweep.main(MC + ["--scheduler", remote.address, "--out", "relative"]) == 0
+    assert json.loads((tmp_path / "relative" / "sweep.json").read_text())["impacts"] == int(MC[1])
+    assert list((tmp_path / "relative" / "sweep.parquet").glob("part-*.parquet"))
+
+
 def test_workers_without_the_package_are_refused_in_one_line(cluster, tmp_path, capsys):
     """A worker started where fraccontact is not installed (no PYTHONPATH
     to this source tree): one line saying so, exit status 2, nothing
@@ -522,9 +533,14 @@ def test_the_benchmarks_quote_the_scaling_report():
     assert "**different**" not in doc and doc.count("(identical)") == 4 and "| identical | yes |" in section
 
 
-def test_ctrl_c_stops_the_sweep_and_leaves_nothing(tmp_path):
-    """SIGINT while the tasks run: exit status 130 within seconds, one line
-    saying so, no traceback, and --out (which the sweep made) gone."""
+@pytest.mark.parametrize("signum, status, said", [
+    (signal.SIGINT, 130, "interrupted; nothing written"),
+    (signal.SIGTERM, 143, "terminated (SIGTERM); nothing written"),  # issue 35 item 14: 26f430c left the hidden folder
+], ids=["ctrl-c", "sigterm"])
+def test_a_signal_stops_the_sweep_and_leaves_nothing(signum, status, said, tmp_path):
+    """SIGINT (Ctrl-C) or SIGTERM (timeout, batch systems) while the tasks
+    run: exit status 128 + the signal within seconds, one line saying so,
+    no traceback, and --out (which the sweep made) gone."""
     out = tmp_path / "out"
     sweeping = subprocess.Popen([sys.executable, "-m", "fraccontact", "sweep", "--monte-carlo", "10000000",
                                  "--scatter", "c=10%", "--workers", "1", "--out", str(out)],
@@ -535,13 +551,13 @@ def test_ctrl_c_stops_the_sweep_and_leaves_nothing(tmp_path):
         while not list(out.glob(".sweep.parquet.*")) and time.monotonic() < deadline:
             time.sleep(0.05)
         time.sleep(0.5)  # the tasks under way
-        sweeping.send_signal(signal.SIGINT)
+        sweeping.send_signal(signum)
         stopped = time.monotonic()
         _, stderr = sweeping.communicate(timeout=30)
     finally:
         if sweeping.poll() is None:
             sweeping.kill()
             sweeping.wait()
-    assert sweeping.returncode == 130 and time.monotonic() - stopped < 10, stderr[-3000:]
-    assert "interrupted; nothing written" in stderr and "Traceback" not in stderr
+    assert sweeping.returncode == status and time.monotonic() - stopped < 10, stderr[-3000:]
+    assert said in stderr and "Traceback" not in stderr
     assert not out.exists()

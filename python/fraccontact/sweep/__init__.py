@@ -71,8 +71,10 @@ in the CSV). Writes to --out:
                   within `bound`, given for each column: see below) of
                   every numeric column over the impacts that succeeded,
                   and printed too.
-The workers write into a hidden folder under --out, moved into place when
-the sweep ends: a failed or interrupted sweep leaves nothing.
+The workers write into a hidden folder under --out (made absolute: a
+worker's working folder need not be this one), moved into place when the
+sweep ends: a failed or interrupted sweep (Ctrl-C: exit status 130;
+SIGTERM: 143) leaves nothing.
 
 The statistics are reduced inside the tasks: each task summarises its
 columns (count, mean, squared deviations; a histogram on bins of 2^-15 of
@@ -85,12 +87,13 @@ two; exact for integers and constants). The statistics are the same bits on
 any cluster.
 
 Runs on a local Dask cluster, by default one worker of --workers threads in
-this process (the library's calls and the Parquet writes release Python's
-GIL; default: the CPUs), or --workers processes with --processes; or on any
-running Dask scheduler (--scheduler ADDRESS, refused when none answers there
-within 5 s), whose workers must import fraccontact (pip install
-'.[sweep]') and see --out (one machine, or a shared file system). A task
-whose worker dies runs again on another: the results are the same.
+the process that runs the sweep (this command's, or that of a program
+calling sweep.main; the library's calls and the Parquet writes release
+Python's GIL; default: the CPUs), or --workers processes with --processes;
+or on any running Dask scheduler (--scheduler ADDRESS, refused when none
+answers there within 5 s), whose workers must import fraccontact (pip
+install '.[sweep]') and see --out (one machine, or a shared file system).
+A task whose worker dies runs again on another: the results are the same.
 Every option is checked, and --out too, before the cluster starts. The wall
 time and the impacts per second count the Dask tasks alone, from the first
 given to the last finished (before, each worker has imported the package).

@@ -135,7 +135,7 @@ def task_size(n, batch):
     """Impacts per task: --batch, else a size that depends on n alone (never
     on the workers, so that the partitions are the same on any cluster):
     about TASKS tasks, each between TASK_MIN and TASK_MAX impacts."""
-    return batch or min(max(math.ceil(n / TASKS), TASK_MIN), TASK_MAX)
+    return batch if batch is not None else min(max(math.ceil(n / TASKS), TASK_MIN), TASK_MAX)
 
 
 def ranges(n, size):

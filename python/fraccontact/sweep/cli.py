@@ -3,12 +3,14 @@ window at a time and their summaries folded on the workers (the
 statistics' among them), then the CSV when asked, the plot and
 sweep.json."""
 
-import ctypes
+import contextlib
 import importlib
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 
 from tqdm import tqdm
@@ -26,12 +28,6 @@ FAN_IN = 8
 # growing with the campaign. A few wakes a second suffice here.
 QUIET = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
          "distributed.admin.system-monitor.interval": "5s", "distributed.worker.memory.monitor-interval": "1s"}
-# glibc's malloc settings in the local workers: arrays below MALLOC_MMAP_THRESHOLD
-# from its heap, and up to MALLOC_TRIM_THRESHOLD of freed memory kept there.
-# Otherwise a task's arrays, freed, go back to the system and the next
-# task's come in fresh pages, each a fault: system time in every task.
-# (environment variable, mallopt's parameter number, value)
-MALLOC = (("MALLOC_MMAP_THRESHOLD_", -3, 32 << 20), ("MALLOC_TRIM_THRESHOLD_", -1, 64 << 20))
 # Tasks given to the cluster at once, for each of its threads: enough to
 # keep every thread busy while the client hears of a finished one.
 WINDOW = 2
@@ -41,25 +37,26 @@ def connect(args):
     """(client, cluster): a Dask client of the scheduler at --scheduler
     (cluster None), refused in one line when none answers there within
     CONNECT_TIMEOUT, or of a local cluster: one worker of --workers threads
-    in this process (the library's calls and pyarrow's writes release the
-    GIL, and nothing is copied between processes), or --workers processes
-    of one thread with --processes."""
+    in the process that runs the sweep (the library's calls and pyarrow's
+    writes release the GIL, and nothing is copied between processes), or
+    --workers processes of one thread with --processes (workers.py)."""
     import dask
     from dask.distributed import Client, LocalCluster
     if not args.scheduler:
-        workers = args.workers or options.cpus()
+        count = args.workers or options.cpus()
         # No dashboard; the scheduler's HTTP server (its metrics) on a free
         # port of the loopback, not on 8787, which another cluster may hold.
         quiet = dict(dashboard_address=None, scheduler_kwargs=dict(dashboard_address="127.0.0.1:0"))
+        from . import workers
         with dask.config.set(QUIET):
-            if not args.processes:
-                keep_freed_memory()
-                cluster = LocalCluster(n_workers=1, threads_per_worker=workers, processes=False, **quiet)
-                return Client(cluster), cluster
-            # In place of the MALLOC_TRIM_THRESHOLD_ Dask's nanny would set.
-            with dask.config.set({f"distributed.nanny.pre-spawn-environ.{name}": value for name, _, value in MALLOC}):
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, **quiet)
-            return Client(cluster), cluster
+            if args.processes:
+                with dask.config.set(workers.environment()):
+                    cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True, **quiet)
+            else:
+                cluster = LocalCluster(n_workers=1, threads_per_worker=count, processes=False, **quiet)
+            client = Client(cluster)
+        client.register_plugin(workers.QuietClose())
+        return client, cluster
     try:
         return Client(args.scheduler, timeout=options.CONNECT_TIMEOUT), None
     except ValueError as e:  # an address Dask cannot parse
@@ -67,13 +64,6 @@ def connect(args):
     except OSError:
         raise ValueError(f"--scheduler {args.scheduler}: no Dask scheduler answered there within "
                          f"{options.CONNECT_TIMEOUT:g} s") from None
-
-
-def keep_freed_memory():
-    """MALLOC in this process, where the C library has mallopt."""
-    mallopt = getattr(ctypes.CDLL(None), "mallopt", None)
-    for _, parameter, value in MALLOC if mallopt else ():
-        mallopt(parameter, value)
 
 
 def fold(client, calls, combine, window, done=None):
@@ -255,7 +245,9 @@ def write(args, plan, staging, count, summary, statistics, counted):
 def close(client, cluster):
     client.close()
     if cluster:
+        from . import workers
         cluster.close()
+        workers.forget()
 
 
 def stop(client, cluster):
@@ -268,6 +260,29 @@ def stop(client, cluster):
         tasks.STATE["stop"] = False
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (what timeout and batch systems send), raised where the
+    signal finds the sweep: the way out Ctrl-C takes."""
+
+
+def raise_terminated(signum, frame):
+    raise Terminated()
+
+
+@contextlib.contextmanager
+def terminated_raises():
+    """SIGTERM raises Terminated inside, where a handler can be set (the
+    main thread); the program's own handler is restored after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
+
+
 def main(argv=None, prog=None):
     parser, args = options.arguments(argv, prog)
     try:
@@ -276,6 +291,20 @@ def main(argv=None, prog=None):
         parser.error(str(e))
     for why in unused:
         print(f"{parser.prog}: warning: {why}", file=sys.stderr)
+    with terminated_raises():
+        try:
+            return connected(parser, args, plan, size)
+        except Terminated:
+            print(f"{parser.prog}: terminated (SIGTERM); nothing written", file=sys.stderr)
+            return 128 + signal.SIGTERM
+        except KeyboardInterrupt:
+            print(f"{parser.prog}: interrupted; nothing written", file=sys.stderr)
+            return 130
+
+
+def connected(parser, args, plan, size):
+    """The sweep on the cluster connect() gives, closed at the end; its exit
+    status."""
     try:
         client, cluster = connect(args)
     except ValueError as e:
@@ -289,8 +318,5 @@ def main(argv=None, prog=None):
     except KilledWorker as e:
         print(f"{parser.prog}: a task's workers died, each in turn ({e}); nothing written", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print(f"{parser.prog}: interrupted; nothing written", file=sys.stderr)
-        return 130
     finally:
         close(client, cluster)

@@ -222,8 +222,8 @@ def refuse_conflicts(args, vary, fixed, scattered):
     if args.workers is not None and not 1 <= args.workers <= cpus():
         raise ValueError(f"--workers {args.workers}: a local cluster has 1 to {cpus()} workers, this machine's "
                          "CPUs (more would only compete for them)")
-    if args.batch < 0:
-        raise ValueError(f"--batch {args.batch}: impacts per Dask task, >= 1 (or 0, the default)")
+    if args.batch is not None and args.batch < 1:
+        raise ValueError(f"--batch {args.batch}: impacts per Dask task, >= 1")
 
 
 def cpus():
@@ -313,12 +313,12 @@ def arguments(argv, prog):
     parser.add_argument("--seed", type=int, help="--monte-carlo: the random generator's seed (default 1)")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler (default: a local cluster)")
     parser.add_argument("--workers", type=int,
-                        help="local cluster: its workers, threads of this process (default: the CPUs, at most as "
-                             "many)")
+                        help="local cluster: its workers, threads of the process that runs the sweep (default: the "
+                             "CPUs, at most as many)")
     parser.add_argument("--processes", action="store_true",
                         help="local cluster: --workers processes of one thread instead of threads")
-    parser.add_argument("--batch", type=int, default=0,
-                        help=f"impacts per Dask task (default: about {cases.TASKS} tasks, "
+    parser.add_argument("--batch", type=int,
+                        help=f"impacts per Dask task, >= 1 (default: about {cases.TASKS} tasks, "
                              f"{cases.TASK_MIN} to {cases.TASK_MAX} impacts each)")
     parser.add_argument("--csv", action="store_true", help="also write every impact to sweep.csv")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("sweep"),

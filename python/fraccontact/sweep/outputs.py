@@ -30,10 +30,10 @@ class Staging:
     """The hidden folder under --out the workers write into."""
 
     def __init__(self, out):
-        self.out = out
-        self.made = [p for p in (out, *out.parents) if not p.exists()]
-        out.mkdir(parents=True, exist_ok=True)
-        self.folder = pathlib.Path(tempfile.mkdtemp(dir=out, prefix=f".{PARTITIONS}."))
+        self.out = out.absolute()  # the workers' working folder need not be this process's
+        self.made = [p for p in (self.out, *self.out.parents) if not p.exists()]
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.folder = pathlib.Path(tempfile.mkdtemp(dir=self.out, prefix=f".{PARTITIONS}."))
 
     def discard(self):
         """Removes what the sweep wrote: the hidden folder, and --out itself
