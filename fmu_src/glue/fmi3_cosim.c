@@ -9,6 +9,7 @@
 
 #include "fmi3Functions.h"
 #include "fmu_instance.h"
+#include "fmu_vars.h"
 #include "guid.h"
 
 /* The states of FMI 3.0 co-simulation (§4.2) this instance can be in, as
@@ -21,6 +22,11 @@ enum {
     STEP_MODE = 1 << 6,
     TERMINATED = 1 << 7
 };
+
+/* As FMI 3.0 §4.2 names them. */
+const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", NULL, NULL, NULL,
+                                                   "Event Mode", "Step Mode", "Terminated"};
+const char *const fmu_type_names[3] = {"a Float64", "an Int32", "a Boolean"};
 
 #define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
 #define AFTER_INIT_ENTERED (INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
@@ -453,8 +459,8 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     if (fi_check_step(&in->base, t, communicationStepSize, 0, "fmi3DoStep") != FI_OK)
         return fmi3Error;
     for (;;) {
-        if (fm_do_step_until(in->base.fm, now, options & FM_CONTINUE ? end - now : communicationStepSize, options,
-                             &event) != FM_OK)
+        if (fm_do_step_until(in->base.fm, now, options & FM_CONTINUE ? end - now : fi_advance(t, communicationStepSize),
+                             options, &event) != FM_OK)
             return fmi3Error;
         now = fm_time(in->base.fm);
         *lastSuccessfulTime = now;
