@@ -268,7 +268,7 @@ static double least_steps(const fc_params *p)
     contact_params q;
     double in_contact, span = least_span(p, &in_contact);
     fc_model_params(p, &q);
-    return (contact_steps_uniformly(&q) ? span : in_contact) / contact_step_limit(&q);
+    return contact_least_steps(&q, span, in_contact);
 }
 
 static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
