@@ -130,8 +130,11 @@ static double least_contact(const contact_model *cm, double H)
 
 int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len)
 {
-    const double steps = contact_least_steps(&cm->p, H, least_contact(cm, H));
+    double steps;
     char text[64];
+    if (!(H / cm->h_max > max_steps)) /* not even all of it in contact: the common case, known at once */
+        return 0;
+    steps = contact_least_steps(&cm->p, H, least_contact(cm, H));
     if (!(steps > max_steps))
         return 0;
     snprintf(msg, len,
