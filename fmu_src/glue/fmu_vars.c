@@ -32,11 +32,13 @@ const fmu_variable *fmu_find(const fmu_variables *vars, unsigned vr, var_type ty
         other = &vars->list[i];
     }
     if (other)
-        fmu_say(r, FM_ERROR, "logStatusError", "value reference %u is not %s variable of this FMU: it is %s, %s variable",
-                vr, fmu_type_names[type], other->name, fmu_type_names[other->type]);
+        fmu_say(r, FM_ERROR, "logStatusError",
+                "value reference %u is not %s variable of this FMU: it is %s, %s variable", vr, fmu_type_names[type],
+                other->name, fmu_type_names[other->type]);
     else
-        fmu_say(r, FM_ERROR, "logStatusError", "value reference %u is not %s variable of this FMU: it has no variable of "
-                "that reference", vr, fmu_type_names[type]);
+        fmu_say(r, FM_ERROR, "logStatusError",
+                "value reference %u is not %s variable of this FMU: it has no variable of that reference", vr,
+                fmu_type_names[type]);
     return NULL;
 }
 
