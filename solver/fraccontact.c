@@ -322,10 +322,6 @@ fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, si
  * history's): well within a tenth of a second of CPU. */
 #define PROGRESS_WORK 8192
 
-/* A step of the full G1 history sums over every step before it: it costs
- * about one unit more per this many of them. */
-#define HISTORY_PER_UNIT 64
-
 /* An error-controlled step costs about this many units: the dashpot's
  * ESDIRK (seven stages) fewer, the springpot's Radau IIA (five coupled
  * stages and two passes over the modes) more. */
@@ -366,7 +362,7 @@ static void watch_run(watch *w, contact_model *cm)
 /* The work of the run's steps from `before` to `after`. */
 static int64_t work_of(const watch *w, int64_t before, int64_t after)
 {
-    return (after - before) * (w->history ? 1 + after / HISTORY_PER_UNIT : w->unit);
+    return w->history ? (int64_t)contact_history_work((double)before, (double)after) : (after - before) * w->unit;
 }
 
 /* Counts the model's steps since the last count and `extra` work, and calls

@@ -267,8 +267,7 @@ static void test_long_steps(void)
     CHECK(fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) == fmi2OK && fmi2EnterInitializationMode(c) == fmi2OK
               && fmi2SetInteger(c, vr, 2, springpot) == fmi2OK && fmi2ExitInitializationMode(c) == fmi2OK,
           "start the full G1 history: %s", last_message);
-    expect_error(fmi2DoStep(c, 0.0, 1e3, fmi2True), "communicationStepSize", "dt_max = 0 (fixed steps of 1e-07 s) is invalid",
-                 "endless step");
+    expect_error(fmi2DoStep(c, 0.0, 1e3, fmi2True), "communicationStepSize", "at most 1048576", "endless step");
     CHECK(get(c, VR_x) == 0.0, "the refused step changed nothing");
     CHECK(fmi2DoStep(c, 0.0, 1e-5, fmi2True) == fmi2OK, "the instance is still usable: %s", last_message);
     fmi2FreeInstance(c);

@@ -483,7 +483,7 @@ static void test_bad_steps(void)
         CHECK(fmi3SetInt32(c, vrs, 2, values, 2) == fmi3OK, "the full G1 history: %s", rec.message);
     }
     start(c);
-    expect_error(step(c, 0.0, 1e3).status, "communicationStepSize = 1000", "more than 1e+09", "endless step");
+    expect_error(step(c, 0.0, 1e3).status, "communicationStepSize = 1000", "at most 1048576", "endless step");
     CHECK(get(c, VR_x) == 0.0 && get(c, 0) == 0.0, "the refused step changed nothing");
     fmi3FreeInstance(c);
 }

@@ -28,7 +28,8 @@ LIMIT = "more than 1e+09"
 # Every method whose internal steps in contact are bounded by dt_max: the G1 law's fixed steps from the
 # start (gap0 = 0) and after a free flight (the step that holds the onset), the Hertz law's
 # error-controlled steps capped by dt_max, the compressed springpot (whose kernel takes no dt_max below
-# about 1e-16 s), a prescribed rate from its onset and in the middle of its contact.
+# about 1e-16 s), a prescribed rate from its onset and in the middle of its contact; and the full G1
+# history, whose steps sum over all before them (1e6 steps from the start: the work of 1.6e10).
 CASES = [
     ("g1", dict(dt_max=1e-300), 0, 0.0, 1e-5, "reset"),
     ("g1-after-flight", dict(dt_max=1e-300, gap0=1e-3), 15, 1e-4, 1e-4, "reset"),
@@ -36,7 +37,9 @@ CASES = [
     ("springpot", dict(dt_max=1e-16, damper=2), 0, 0.0, 1e-5, "reset"),
     ("driven", dict(dt_max=1e-300, scene=2, m=0.0, v=0.1), 0, 0.0, 1e-5, "reset"),
     ("driven-in-contact", dict(dt_max=1e-9, scene=2, m=0.0, v=0.1), 1, 1e-5, 10.0, "step"),
+    ("g1-history", dict(dt_max=1e-7, damper=2, memory=1), 0, 0.0, 0.1, "step"),
 ]
+NAMED = {"g1-history": "memory = 1 (the full G1 history) is invalid"}
 
 
 class Instance:
@@ -147,7 +150,8 @@ def test_a_step_beyond_the_step_limit_is_refused_at_once(refusals, case):
     name, values = case[:2]
     r = refusals[name]
     assert not r["taken"], r
-    assert f"dt_max = {values['dt_max']:g} is invalid" in r["message"] and LIMIT in r["message"], r["message"]
+    named = NAMED.get(name, f"dt_max = {values['dt_max']:g} is invalid")
+    assert named in r["message"] and LIMIT in r["message"], r["message"]
     assert r["seconds"] < 0.05  # before any internal step: microseconds (the child's clock)
     assert r["after"] == r["fresh"]
 

@@ -625,8 +625,8 @@ static fm_status drive(fmu_model *fm, double H, double v)
     const double inv_m = cm->inv_m, accel = cm->accel, contact_step = cm->contact_step;
     char why[512];
     contact_drive(cm, v, proxy_mass(&fm->in), fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
-    if (contact_check_work(cm, H, MAX_STEPS, why, sizeof why) == 0
-        && contact_check_advance(cm, H, why, sizeof why) == 0)
+    if (contact_check_advance(cm, H, why, sizeof why) == 0
+        && contact_check_work(cm, H, MAX_STEPS, why, sizeof why) == 0)
         return FM_OK;
     cm->s = s;
     cm->inv_m = inv_m;

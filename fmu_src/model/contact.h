@@ -68,6 +68,11 @@ enum contact_memory {
  * steps (8 MiB of history, and as much for the G1 weights). */
 #define CONTACT_G1_HISTORY_MAX 1048576
 
+/* A step of the full G1 history sums over every step before it: it costs
+ * about one unit of work (an internal step of the compressed memory, the
+ * dearest step but this one) more per this many of them. */
+#define CONTACT_HISTORY_PER_UNIT 64
+
 /* The method a configuration runs, each in a file named for it: decided by
  * contact_method alone, and named by contact_method_name. */
 enum contact_method {
@@ -297,6 +302,11 @@ double contact_step_limit(const contact_params *p);
  * before the first step; INFINITY or NaN never pass a limit. */
 double contact_least_steps(const contact_params *p, double span, double in_contact);
 
+/* The work of the full G1 history's steps after the before-th up to the
+ * after-th, in units of one internal step: each costs
+ * 1 + after / CONTACT_HISTORY_PER_UNIT (whole units, as the counts are). */
+double contact_history_work(double before, double after);
+
 /* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
  * `scene` with the parameters *p (which must have passed their check): a
  * run must also be able to hold its energies and powers in doubles. */
@@ -373,8 +383,9 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
  * by contact_least_steps, with the least time in contact known from the
  * state: from the free flight's onset inside the advance, or from now in
  * contact, until a striker with inertia can have turned back or a
- * prescribed rate reverses (none where nothing bounds it). 0, or -1 and a
- * message naming dt_max, its value and the rule. */
+ * prescribed rate reverses (none where nothing bounds it); for the full G1
+ * history the work of its steps (contact_history_work) instead. 0, or -1
+ * and a message naming dt_max or memory, its value and the rule. */
 int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len);
 
 /* Whether the full G1 history (memory = 1) holds a run from the start that

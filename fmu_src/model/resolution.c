@@ -128,10 +128,29 @@ static double least_contact(const contact_model *cm, double H)
     return fmin(H - onset, fmax(turn, 0.0));
 }
 
+/* The full G1 history's advance by H (whole steps of dt_max, as
+ * contact_check_advance takes them): each step sums over all before it. */
+static int check_history_work(const contact_model *cm, double H, double max_work, char *msg, size_t len)
+{
+    const double before = (double)cm->s.steps, after = before + floor(H / cm->h_max + 0.5);
+    const double work = contact_history_work(before, after);
+    char text[32];
+    if (!(work > max_work))
+        return 0;
+    snprintf(msg, len,
+             "memory = 1 (the full G1 history) is invalid for this advance from t = %.17g s: its %.3g steps of "
+             "dt_max = %s s would sum over up to %.3g steps each, the work of %.3g internal steps (one more per %d "
+             "summed), more than %.0e; use memory = 2, a larger dt_max, or shorter advances (communication steps)",
+             cm->s.t, after - before, shown(cm->h_max, text), after, work, CONTACT_HISTORY_PER_UNIT, max_work);
+    return -1;
+}
+
 int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len)
 {
     double steps;
     char text[64];
+    if (full_history(cm))
+        return check_history_work(cm, H, max_steps, msg, len);
     if (!(H / cm->h_max > max_steps)) /* not even all of it in contact: the common case, known at once */
         return 0;
     steps = contact_least_steps(&cm->p, H, least_contact(cm, H));
