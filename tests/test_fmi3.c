@@ -173,7 +173,7 @@ static void event_mode(fmi3Instance c)
 static void test_refusals_name_what_they_refuse(void)
 {
     fmi3Instance c = plain("names");
-    fmi3ValueReference c_vr = VR_c, law_vr = VR_law, none = 999;
+    fmi3ValueReference c_vr = VR_c, law_vr = VR_law, none = 999, time_vr = 0;
     fmi3Int32 i;
     fmi3Float64 r;
     start(c);
@@ -186,6 +186,9 @@ static void test_refusals_name_what_they_refuse(void)
     expect_message(fmi3GetFloat64(c, &none, 1, &r, 1),
                    "value reference 999 is not a Float64 variable of this FMU: it has no variable of that reference",
                    "a reference of no variable");
+    expect_message(fmi3GetInt32(c, &time_vr, 1, &i, 1),
+                   "value reference 0 is not an Int32 variable of this FMU: it is time, a Float64 variable",
+                   "an Int32 call for the independent variable");
     CHECK(step(c, 0.0, 1e-5).status == fmi3OK && fmi3Terminate(c) == fmi3OK, "step, terminate: %s", rec.message);
     expect_message(step(c, 1e-5, 1e-5).status,
                    "fmi3DoStep: illegal call sequence: called in state Terminated, allowed only in Step Mode",

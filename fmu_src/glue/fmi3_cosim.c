@@ -288,29 +288,50 @@ static fm_status set_float64(instance *in, fmi3ValueReference vr, fmi3Float64 va
     return FM_ERROR;
 }
 
+/* The independent variable is the glue's, not the model's: a call of
+ * another type for it is refused here, as the model refuses its own. */
+static int is_time(instance *in, fmi3ValueReference vr, var_type type)
+{
+    if (vr != VR_TIME)
+        return 0;
+    fi_fail(&in->base, "value reference %u is not %s variable of this FMU: it is time, %s variable", vr,
+            fmu_type_names[type], fmu_type_names[VAR_REAL]);
+    return 1;
+}
+
 static fm_status get_int32(instance *in, fmi3ValueReference vr, fmi3Int32 *value)
 {
     int i;
-    fm_status status = fm_get_integer(in->base.fm, vr, &i);
+    fm_status status;
+    if (is_time(in, vr, VAR_INTEGER))
+        return FM_ERROR;
+    status = fm_get_integer(in->base.fm, vr, &i);
     *value = i;
     return status;
 }
 
 static fm_status set_int32(instance *in, fmi3ValueReference vr, fmi3Int32 value)
 {
+    if (is_time(in, vr, VAR_INTEGER))
+        return FM_ERROR;
     return fm_set_integer(in->base.fm, vr, value);
 }
 
 static fm_status get_boolean(instance *in, fmi3ValueReference vr, fmi3Boolean *value)
 {
     int b = 0;
-    fm_status status = fm_get_boolean(in->base.fm, vr, &b);
+    fm_status status;
+    if (is_time(in, vr, VAR_BOOLEAN))
+        return FM_ERROR;
+    status = fm_get_boolean(in->base.fm, vr, &b);
     *value = b != 0;
     return status;
 }
 
 static fm_status set_boolean(instance *in, fmi3ValueReference vr, fmi3Boolean value)
 {
+    if (is_time(in, vr, VAR_BOOLEAN))
+        return FM_ERROR;
     return fm_set_boolean(in->base.fm, vr, value);
 }
 
