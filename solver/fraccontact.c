@@ -287,7 +287,7 @@ static double least_steps(const fc_params *p)
     contact_params q;
     double in_contact, span = least_span(p, &in_contact);
     fc_model_params(p, &q);
-    return (contact_steps_uniformly(&q) ? span : in_contact) / contact_step_limit(&q);
+    return contact_least_steps(&q, span, in_contact);
 }
 
 static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
@@ -341,10 +341,6 @@ fc_status fc_run_check(const fc_params *p, double output_interval, char *msg, si
  * history's): well within a tenth of a second of CPU. */
 #define PROGRESS_WORK 8192
 
-/* A step of the full G1 history sums over every step before it: it costs
- * about one unit more per this many of them. */
-#define HISTORY_PER_UNIT 64
-
 /* An error-controlled step costs about this many units: the dashpot's
  * ESDIRK (seven stages) fewer, the springpot's Radau IIA (five coupled
  * stages and two passes over the modes) more. */
@@ -385,7 +381,7 @@ static void watch_run(watch *w, contact_model *cm)
 /* The work of the run's steps from `before` to `after`. */
 static int64_t work_of(const watch *w, int64_t before, int64_t after)
 {
-    return (after - before) * (w->history ? 1 + after / HISTORY_PER_UNIT : w->unit);
+    return w->history ? (int64_t)contact_history_work((double)before, (double)after) : (after - before) * w->unit;
 }
 
 /* Counts the model's steps since the last count and `extra` work, and calls

@@ -131,6 +131,13 @@ static void expect_error(fmi3Status status, const char *a, const char *b, const 
           "%s: log \"%s\" should name \"%s\"%s%s", what, rec.message, a, b ? " and " : "", b ? b : "");
 }
 
+/* The status is an error and the log says exactly `message`. */
+static void expect_message(fmi3Status status, const char *message, const char *what)
+{
+    CHECK(status == fmi3Error && rec.status == fmi3Error && strcmp(rec.message, message) == 0,
+          "%s: status %d, log \"%s\", not \"%s\"", what, (int)status, rec.message, message);
+}
+
 /* The results of a DoStep. */
 typedef struct {
     fmi3Status status;
@@ -159,6 +166,72 @@ static void event_mode(fmi3Instance c)
 {
     CHECK(fmi3EnterEventMode(c) == fmi3OK, "enter event mode: %s", rec.message);
     update_discrete(c);
+}
+
+/* A refusal names the variable and the function, in FMI 3.0's words: its
+ * types (Float64, Int32) and states (Step Mode, Terminated). */
+static void test_refusals_name_what_they_refuse(void)
+{
+    fmi3Instance c = plain("names");
+    fmi3ValueReference c_vr = VR_c, law_vr = VR_law, none = 999, time_vr = 0;
+    fmi3Int32 i;
+    fmi3Float64 r;
+    start(c);
+    expect_message(fmi3GetInt32(c, &c_vr, 1, &i, 1),
+                   "value reference 9 is not an Int32 variable of this FMU: it is c, a Float64 variable",
+                   "an Int32 call for a Float64");
+    expect_message(fmi3GetFloat64(c, &law_vr, 1, &r, 1),
+                   "value reference 30 is not a Float64 variable of this FMU: it is law, an Int32 variable",
+                   "a Float64 call for an Int32");
+    expect_message(fmi3GetFloat64(c, &none, 1, &r, 1),
+                   "value reference 999 is not a Float64 variable of this FMU: it has no variable of that reference",
+                   "a reference of no variable");
+    expect_message(fmi3GetInt32(c, &time_vr, 1, &i, 1),
+                   "value reference 0 is not an Int32 variable of this FMU: it is time, a Float64 variable",
+                   "an Int32 call for the independent variable");
+    CHECK(step(c, 0.0, 1e-5).status == fmi3OK && fmi3Terminate(c) == fmi3OK, "step, terminate: %s", rec.message);
+    expect_message(step(c, 1e-5, 1e-5).status,
+                   "fmi3DoStep: illegal call sequence: called in state Terminated, allowed only in Step Mode",
+                   "a step after terminate");
+    expect_message(set(c, VR_v, 1.0),
+                   "fmi3SetFloat64: illegal call sequence: called in state Terminated, allowed only in Instantiated, "
+                   "Initialization Mode, Event Mode or Step Mode",
+                   "an input after terminate");
+    fmi3FreeInstance(c);
+}
+
+/* A communication step that does not advance time (t + H == t) changes
+ * nothing: every output of an instance given such steps inside an impact
+ * is that of one not given them, there and after the impact. (The G1 law
+ * counts internal steps: one more changed eps by about 1e-9.) */
+static void test_steps_that_do_not_advance_time(void)
+{
+    fmi3Instance a = plain("slivers"), b = plain("plain");
+    double t = 0.0, ya[N_OUT], yb[N_OUT];
+    step_result s;
+    int k;
+    start(a);
+    start(b);
+    for (k = 0; k < H20_STEPS; k++) {
+        if (k == 100) {
+            s = step(a, t, 5e-324);
+            CHECK(s.status == fmi3OK && s.last == t && !s.early, "a step of 5e-324 s at t = %g: %s", t, rec.message);
+            s = step(a, t, 1e-20);
+            CHECK(s.status == fmi3OK && s.last == t && t + 1e-20 == t, "a step of 1e-20 s: %s", rec.message);
+        }
+        if (k == 100 || k == H20_STEPS - 1) {
+            CHECK(fmi3GetFloat64(a, outputs, N_OUT, ya, N_OUT) == fmi3OK
+                      && fmi3GetFloat64(b, outputs, N_OUT, yb, N_OUT) == fmi3OK,
+                  "outputs");
+            CHECK(memcmp(ya, yb, sizeof ya) == 0, "at t = %g the outputs are those of a run without the slivers "
+                  "(eps %.17g, %.17g; x2 %.17g, %.17g)", t, ya[8], yb[8], ya[5], yb[5]);
+        }
+        CHECK(step(a, t, H20_STEP).status == fmi3OK && step(b, t, H20_STEP).status == fmi3OK, "step %d", k);
+        t += H20_STEP;
+    }
+    CHECK(yb[8] > 0.5, "the impact ended: eps = %g", yb[8]);
+    fmi3FreeInstance(a);
+    fmi3FreeInstance(b);
 }
 
 /* ------------------------------------------------------------ instantiation */
@@ -413,7 +486,7 @@ static void test_bad_steps(void)
         CHECK(fmi3SetInt32(c, vrs, 2, values, 2) == fmi3OK, "the full G1 history: %s", rec.message);
     }
     start(c);
-    expect_error(step(c, 0.0, 1e3).status, "communicationStepSize = 1000", "1e9", "endless step");
+    expect_error(step(c, 0.0, 1e3).status, "communicationStepSize = 1000", "at most 1048576", "endless step");
     CHECK(get(c, VR_x) == 0.0 && get(c, 0) == 0.0, "the refused step changed nothing");
     fmi3FreeInstance(c);
 }
@@ -1213,6 +1286,8 @@ int main(int argc, char **argv)
     load_fmi2(argc > 1 ? argv[1] : NULL);
     test_instantiate();
     test_state_machine();
+    test_refusals_name_what_they_refuse();
+    test_steps_that_do_not_advance_time();
     test_non_finite();
     test_out_of_range();
     test_bad_steps();

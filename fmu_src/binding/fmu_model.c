@@ -523,7 +523,7 @@ static void predict(fmu_model *fm, double H)
     p->valid = 0;
     /* The full G1 history's struct copy shares its buffer: room for the
      * predicted steps first, so that the copy never reallocates it. */
-    if (contact_check_advance(cm, H, why, sizeof why) != 0
+    if (contact_check_advance(cm, H, why, sizeof why) != 0 || contact_check_work(cm, H, MAX_STEPS, why, sizeof why) != 0
         || (contact_steps_uniformly(&cm->p)
             && contact_memory_resize(cm, contact_memory_count(cm) + (size_t)floor(H / cm->h_max + 0.5)) != 0))
         return;
@@ -590,12 +590,33 @@ static void account_step(fmu_model *fm, double H, const contact_state *start, do
     fm->correction = coupling_energy_correction(&next, m);
 }
 
+/* The model driven by the inputs for a step of length H > 0 from the
+ * velocity v (contact_drive), or FM_ERROR, reported, and the model as it
+ * was where the step cannot be taken: off the full G1 history's grid, or
+ * in more than MAX_STEPS internal steps, known before the first
+ * (contact_check_work; the model's max_steps stops the others). */
+static fm_status drive(fmu_model *fm, double H, double v)
+{
+    contact_model *cm = &fm->model;
+    const contact_state s = cm->s;
+    const double inv_m = cm->inv_m, accel = cm->accel, contact_step = cm->contact_step;
+    char why[512];
+    contact_drive(cm, v, proxy_mass(&fm->in), fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
+    if (contact_check_advance(cm, H, why, sizeof why) == 0
+        && contact_check_work(cm, H, MAX_STEPS, why, sizeof why) == 0)
+        return FM_OK;
+    cm->s = s;
+    cm->inv_m = inv_m;
+    cm->accel = accel;
+    cm->contact_step = contact_step;
+    return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
+}
+
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event)
 {
     contact_model *cm = &fm->model;
     contact_state before;
     memory_copy memory;
-    char why[512];
     double impulse, part, t_start, end, v_end;
     const fmu_variable *overflow;
     /* the outputs and the coupling's account as they were, for a refusal */
@@ -610,20 +631,17 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     const double correction = fm->correction;
     int from_prediction, other_coupling;
     *event = 0;
-    /* A refused step changes nothing, so the checks come first: a uniform
-     * grid's steps are known in advance (the others' are counted as they
-     * are taken: MAX_STEPS, the model's max_steps). */
-    if (contact_steps_uniformly(&cm->p) && H / cm->h_max > MAX_STEPS)
-        return report(fm, FM_ERROR, "logStatusError",
-                      "DoStep: communicationStepSize = %g takes more than 1e9 internal steps of dt_max = %g s on "
-                      "the uniform grid; take shorter communication steps or a larger dt_max", H, cm->h_max);
-    if (H > 0.0 && contact_check_advance(cm, H, why, sizeof why) != 0)
-        return report(fm, FM_ERROR, "logStatusError", "DoStep: communicationStepSize = %.17g: %s", H, why);
-    fm_update_discrete(fm); /* a new step: the master has seen the last event */
     if (H == 0.0) {
+        fm_update_discrete(fm); /* a new step: the master has seen the last event */
         cm->s.t = t; /* the master's: the glue let it differ from ours by rounding only */
         return FM_OK;
     }
+    t_start = cm->s.t;
+    v_end = cm->s.v;
+    /* A refused step changes nothing, so the checks come first */
+    if (drive(fm, H, start_velocity(fm, v_end, &other_coupling)) != FM_OK)
+        return FM_ERROR;
+    fm_update_discrete(fm);
     if (!resume) { /* a new communication step: what a Jacobi master applies over it, where and how long */
         fm->announced = fm->F_avg_next;
         fm->step_start = t;
@@ -631,10 +649,6 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     if (accounted) /* the inputs end the bodies' last interval */
         coupling_energy_close(&fm->energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
-    t_start = cm->s.t;
-    v_end = cm->s.v;
-    contact_drive(cm, start_velocity(fm, v_end, &other_coupling), proxy_mass(&fm->in),
-                  fm->in.m > 0.0 ? other_accel(&fm->in) : fm->v_slope);
     if (accounted)
         coupling_energy_restart(&fm->energy, fm->coupling == COUPLING_JACOBI ? fm->owed : 0.0, cm->s.v - v_end);
     before = cm->s;

@@ -11,6 +11,7 @@
 
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
+#include "fmu_vars.h"
 #include "guid.h"
 
 /* The states of FMI 2.0 §4.2.4 that this slave can be in, as bits, so that
@@ -25,6 +26,11 @@ enum {
     STEP_COMPLETE = 1 << 2,
     TERMINATED = 1 << 4
 };
+
+/* As FMI 2.0 §4.2.4 names them. */
+const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", "Step Complete", NULL,
+                                                   "Terminated"};
+const char *const fmu_type_names[3] = {"a Real", "an Integer", "a Boolean"};
 
 #define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
 #define AFTER_INIT_ENTERED (INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
@@ -265,7 +271,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     REQUIRE(STEP_COMPLETE, "fmi2DoStep");
     if (fi_check_step(&in->base, t, H, 1, "fmi2DoStep") != FI_OK)
         return fmi2Error;
-    return fm_do_step(in->base.fm, t, H) == FM_OK ? fmi2OK : fmi2Error;
+    return fm_do_step(in->base.fm, t, fi_advance(t, H)) == FM_OK ? fmi2OK : fmi2Error;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)

@@ -9,6 +9,7 @@
 
 #include "fmi3Functions.h"
 #include "fmu_instance.h"
+#include "fmu_vars.h"
 #include "guid.h"
 
 /* The states of FMI 3.0 co-simulation (§4.2) this instance can be in, as
@@ -21,6 +22,11 @@ enum {
     STEP_MODE = 1 << 6,
     TERMINATED = 1 << 7
 };
+
+/* As FMI 3.0 §4.2 names them. */
+const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", NULL, NULL, NULL,
+                                                   "Event Mode", "Step Mode", "Terminated"};
+const char *const fmu_type_names[3] = {"a Float64", "an Int32", "a Boolean"};
 
 #define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
 #define AFTER_INIT_ENTERED (INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
@@ -282,29 +288,50 @@ static fm_status set_float64(instance *in, fmi3ValueReference vr, fmi3Float64 va
     return FM_ERROR;
 }
 
+/* The independent variable is the glue's, not the model's: a call of
+ * another type for it is refused here, as the model refuses its own. */
+static int is_time(instance *in, fmi3ValueReference vr, var_type type)
+{
+    if (vr != VR_TIME)
+        return 0;
+    fi_fail(&in->base, "value reference %u is not %s variable of this FMU: it is time, %s variable", vr,
+            fmu_type_names[type], fmu_type_names[VAR_REAL]);
+    return 1;
+}
+
 static fm_status get_int32(instance *in, fmi3ValueReference vr, fmi3Int32 *value)
 {
     int i;
-    fm_status status = fm_get_integer(in->base.fm, vr, &i);
+    fm_status status;
+    if (is_time(in, vr, VAR_INTEGER))
+        return FM_ERROR;
+    status = fm_get_integer(in->base.fm, vr, &i);
     *value = i;
     return status;
 }
 
 static fm_status set_int32(instance *in, fmi3ValueReference vr, fmi3Int32 value)
 {
+    if (is_time(in, vr, VAR_INTEGER))
+        return FM_ERROR;
     return fm_set_integer(in->base.fm, vr, value);
 }
 
 static fm_status get_boolean(instance *in, fmi3ValueReference vr, fmi3Boolean *value)
 {
     int b = 0;
-    fm_status status = fm_get_boolean(in->base.fm, vr, &b);
+    fm_status status;
+    if (is_time(in, vr, VAR_BOOLEAN))
+        return FM_ERROR;
+    status = fm_get_boolean(in->base.fm, vr, &b);
     *value = b != 0;
     return status;
 }
 
 static fm_status set_boolean(instance *in, fmi3ValueReference vr, fmi3Boolean value)
 {
+    if (is_time(in, vr, VAR_BOOLEAN))
+        return FM_ERROR;
     return fm_set_boolean(in->base.fm, vr, value);
 }
 
@@ -453,8 +480,8 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     if (fi_check_step(&in->base, t, communicationStepSize, 0, "fmi3DoStep") != FI_OK)
         return fmi3Error;
     for (;;) {
-        if (fm_do_step_until(in->base.fm, now, options & FM_CONTINUE ? end - now : communicationStepSize, options,
-                             &event) != FM_OK)
+        if (fm_do_step_until(in->base.fm, now, options & FM_CONTINUE ? end - now : fi_advance(t, communicationStepSize),
+                             options, &event) != FM_OK)
             return fmi3Error;
         now = fm_time(in->base.fm);
         *lastSuccessfulTime = now;

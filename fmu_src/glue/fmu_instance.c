@@ -77,12 +77,45 @@ void fi_release(fmu_instance *in)
     free(in->name);
 }
 
+static const char *state_name(int state)
+{
+    int i;
+    for (i = 0; i < FI_STATE_BITS; i++)
+        if (state == 1 << i && fi_state_names[i])
+            return fi_state_names[i];
+    return "unknown";
+}
+
+/* "Instantiated, Initialization Mode or Step Mode": the states of the mask. */
+static void state_list(int states, char *text, size_t len)
+{
+    int i, left = 0;
+    size_t used = 0;
+    text[0] = '\0';
+    for (i = 0; i < FI_STATE_BITS; i++)
+        left += (states >> i & 1) && fi_state_names[i];
+    for (i = 0; i < FI_STATE_BITS && used < len; i++) {
+        if (!(states >> i & 1) || !fi_state_names[i])
+            continue;
+        left--;
+        used += (size_t)snprintf(text + used, len - used, "%s%s", fi_state_names[i],
+                                 left > 1 ? ", " : left == 1 ? " or " : "");
+    }
+}
+
 int fi_allowed(fmu_instance *in, int states, const char *name)
 {
+    char allowed[160];
     if (!in)
         return 0;
     if (!(in->state & states)) {
-        fi_fail(in, "%s: illegal call sequence (not allowed in the current state)", name);
+        state_list(states, allowed, sizeof allowed);
+        if (allowed[0])
+            fi_fail(in, "%s: illegal call sequence: called in state %s, allowed only in %s", name,
+                    state_name(in->state), allowed);
+        else
+            fi_fail(in, "%s: illegal call sequence: called in state %s, allowed in no state of this FMU", name,
+                    state_name(in->state));
         return 0;
     }
     fi_log(in, FI_OK, "logCalls", name);
@@ -130,6 +163,11 @@ fi_status fi_check_step(const fmu_instance *in, double t, double H, int zero_all
     if (fabs(t - now) > 1e-6 * H + 1e-12 * fabs(t))
         return fi_fail(in, "%s: currentCommunicationPoint = %.17g does not match the FMU's time %.17g", name, t, now);
     return FI_OK;
+}
+
+double fi_advance(double t, double H)
+{
+    return t + H == t ? 0.0 : H;
 }
 
 /* ------------------------------------------------------------ FMU state */

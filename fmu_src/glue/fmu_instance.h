@@ -47,8 +47,14 @@ __attribute__((format(printf, 2, 3)))
 #endif
 fi_status fi_fail(const fmu_instance *in, const char *fmt, ...);
 
+/* The names of the version's states, fi_state_names[i] that of the state
+ * 1 << i (NULL where no state has that bit): defined by its glue. */
+#define FI_STATE_BITS 8
+extern const char *const fi_state_names[FI_STATE_BITS];
+
 /* Whether function `name` may be called in the current state (a bit mask
- * of the version's states); logs the call when asked to. */
+ * of the version's states); logs the call when asked to, and a refusal
+ * naming the function, the state and the states it is allowed in. */
 int fi_allowed(fmu_instance *in, int states, const char *name);
 
 /* Whether an array of n > 0 values is missing (after logging an error). */
@@ -61,6 +67,11 @@ fi_status fi_set_debug_logging(fmu_instance *in, int logging_on, size_t n, const
  * both finite, H > 0 (or 0 where zero_allowed: FMI 2.0 allows it, 3.0 does
  * not), and t the model's time up to the master's rounding. */
 fi_status fi_check_step(const fmu_instance *in, double t, double H, int zero_allowed, const char *name);
+
+/* The step the model takes for a communication step of size H from t: none
+ * (0) where t + H rounds to t, since time does not advance (a model that
+ * counts its internal steps would still count one); else H. */
+double fi_advance(double t, double H);
 
 /* ------------------------------------------------------------ FMU state */
 

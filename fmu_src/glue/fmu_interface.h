@@ -41,7 +41,8 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop);
 
 /* One communication step [t, t + H], and the model's time. The glue has
  * checked that H is finite and >= 0 and that t is the model's time up to
- * the master's rounding: the model takes t as its time. */
+ * the master's rounding: the model takes t as its time. H is 0 where the
+ * master's step does not advance time (t + H == t, fi_advance). */
 fm_status fm_do_step(fmu_model *fm, double t, double H);
 double fm_time(const fmu_model *fm);
 

@@ -7,8 +7,6 @@
 
 #include "serial.h"
 
-/* Named as both FMI versions call them. */
-static const char *const type_names[] = {"a Real (Float64)", "an Integer (Int32)", "a Boolean"};
 
 fm_status fmu_say(const fmu_reporter *r, fm_status status, const char *category, const char *fmt, ...)
 {
@@ -24,12 +22,23 @@ fm_status fmu_say(const fmu_reporter *r, fm_status status, const char *category,
 
 const fmu_variable *fmu_find(const fmu_variables *vars, unsigned vr, var_type type, const fmu_reporter *r)
 {
+    const fmu_variable *other = NULL;
     size_t i;
-    for (i = 0; i < vars->count; i++)
-        if (vars->list[i].vr == vr && vars->list[i].type == type)
+    for (i = 0; i < vars->count; i++) {
+        if (vars->list[i].vr != vr)
+            continue;
+        if (vars->list[i].type == type)
             return &vars->list[i];
-    fmu_say(r, FM_ERROR, "logStatusError", "value reference %u is not %s variable of this FMU", vr,
-            type_names[type]);
+        other = &vars->list[i];
+    }
+    if (other)
+        fmu_say(r, FM_ERROR, "logStatusError",
+                "value reference %u is not %s variable of this FMU: it is %s, %s variable", vr, fmu_type_names[type],
+                other->name, fmu_type_names[other->type]);
+    else
+        fmu_say(r, FM_ERROR, "logStatusError",
+                "value reference %u is not %s variable of this FMU: it has no variable of that reference", vr,
+                fmu_type_names[type]);
     return NULL;
 }
 

@@ -35,7 +35,13 @@ __attribute__((format(printf, 4, 5)))
 #endif
 fm_status fmu_say(const fmu_reporter *r, fm_status status, const char *category, const char *fmt, ...);
 
-/* The variable of that reference and type, or NULL after an error report. */
+/* The types as the FMU's FMI version names them, with their article ("a Real",
+ * "a Float64"), indexed by var_type: defined by its glue (fmi2_cosim.c,
+ * fmi3_cosim.c). */
+extern const char *const fmu_type_names[3];
+
+/* The variable of that reference and type, or NULL after an error report
+ * naming the variable that reference has, if any, and its type. */
 const fmu_variable *fmu_find(const fmu_variables *vars, unsigned vr, var_type type, const fmu_reporter *r);
 
 /* The same, and NULL after a report if it may not be set now: outputs never,

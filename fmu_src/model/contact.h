@@ -68,6 +68,11 @@ enum contact_memory {
  * steps (8 MiB of history, and as much for the G1 weights). */
 #define CONTACT_G1_HISTORY_MAX 1048576
 
+/* A step of the full G1 history sums over every step before it: it costs
+ * about one unit of work (an internal step of the compressed memory, the
+ * dearest step but this one) more per this many of them. */
+#define CONTACT_HISTORY_PER_UNIT 64
+
 /* The method a configuration runs, each in a file named for it: decided by
  * contact_method alone, and named by contact_method_name. */
 enum contact_method {
@@ -290,6 +295,18 @@ int contact_error_controlled(const contact_params *p);
  * land on an interval's end or to resolve a contact, contact_advance). */
 double contact_step_limit(const contact_params *p);
 
+/* The fewest internal steps a run or an advance of `span` seconds takes
+ * that spends at least `in_contact` of them in contact: steps of at most
+ * contact_step_limit over the whole span on a uniform grid, over the
+ * contact otherwise (free flight is one step). What a caller refuses
+ * before the first step; INFINITY or NaN never pass a limit. */
+double contact_least_steps(const contact_params *p, double span, double in_contact);
+
+/* The work of the full G1 history's steps after the before-th up to the
+ * after-th, in units of one internal step: each costs
+ * 1 + after / CONTACT_HISTORY_PER_UNIT (whole units, as the counts are). */
+double contact_history_work(double before, double after);
+
 /* The same for the striker inputs, velocity v [m/s] and mass m [kg], in
  * `scene` with the parameters *p (which must have passed their check): a
  * run must also be able to hold its energies and powers in doubles. */
@@ -383,6 +400,15 @@ void contact_memory_set(contact_model *cm, size_t i, double value);
  * the grid of dt_max (H a whole multiple of it, to 1e-9) and holds at most
  * CONTACT_G1_HISTORY_MAX steps. 0, or -1 and a message. */
 int contact_check_advance(const contact_model *cm, double H, char *msg, size_t len);
+
+/* Whether an advance by H from here takes at most max_steps internal steps
+ * by contact_least_steps, with the least time in contact known from the
+ * state: from the free flight's onset inside the advance, or from now in
+ * contact, until a striker with inertia can have turned back or a
+ * prescribed rate reverses (none where nothing bounds it); for the full G1
+ * history the work of its steps (contact_history_work) instead. 0, or -1
+ * and a message naming dt_max or memory, its value and the rule. */
+int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len);
 
 /* Whether the full G1 history (memory = 1) holds a run from the start that
  * may go on for `span` [s], named `name` (t_end, stopTime) in the message:

@@ -74,4 +74,14 @@ double contact_step_limit(const contact_params *p)
     return contact_error_controlled(p) ? INFINITY : CONTACT_DEFAULT_STEP;
 }
 
+double contact_least_steps(const contact_params *p, double span, double in_contact)
+{
+    return (uniform_grid(p) ? span : in_contact) / contact_step_limit(p);
+}
+
+double contact_history_work(double before, double after)
+{
+    return (after - before) * (1.0 + floor(after / CONTACT_HISTORY_PER_UNIT));
+}
+
 int contact_steps_uniformly(const contact_params *p) { return uniform_grid(p); }

@@ -1,6 +1,7 @@
 /* Whether fixed steps resolve an impact: the time a striker takes to stop,
  * the uniform grids' check of dt_max against it, the warning where SDIRK2's
- * fixed steps are refined in contact, and the fixed step of a contact. */
+ * fixed steps are refined in contact, the fixed step of a contact, and the
+ * check that an advance takes no more steps than a caller allows. */
 #include <math.h>
 #include <stdio.h>
 
@@ -97,6 +98,69 @@ int contact_step_warning(const contact_params *p, double v, double m, char *msg,
              shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t, CONTACT_RESOLUTION,
              t / CONTACT_REFINED, CONTACT_REFINED);
     return 1;
+}
+
+/* The least time an advance by H from the model's state spends in contact
+ * (contact_check_work). The turnaround time after the onset is the fastest
+ * a striker stops (x_max / v, the elastic spring's, which slows it down all
+ * the way; a damper in series only softens it), and a striker pressing in
+ * stays in contact until it stops: at x1 = 0 the force vanishes and x1'
+ * is v. A prescribed rate stays in contact until it reverses. */
+static double least_contact(const contact_model *cm, double H)
+{
+    const contact_state *s = &cm->s;
+    double onset = 0.0, since = 0.0, v = s->v, turn;
+    if (!s->in_contact) {
+        onset = flight_onset(s->x1, s->v, cm->accel, H);
+        if (onset < 0.0)
+            return 0.0;
+        v += cm->accel * onset;
+    } else if (cm->inv_m > 0.0) {
+        since = s->t - s->t_onset;
+        v = s->v > 0.0 ? s->v_onset : 0.0;
+    }
+    if (!(v > 0.0))
+        return 0.0;
+    if (!(cm->inv_m > 0.0))
+        turn = cm->accel < 0.0 ? v / -cm->accel : INFINITY;
+    else /* a striker pulled away may turn sooner */
+        turn = cm->accel >= 0.0 ? turnaround_time(cm->p.spring_exponent, cm->k, cm->inv_m, v, cm->accel) - since : 0.0;
+    return fmin(H - onset, fmax(turn, 0.0));
+}
+
+/* The full G1 history's advance by H (whole steps of dt_max, as
+ * contact_check_advance takes them): each step sums over all before it. */
+static int check_history_work(const contact_model *cm, double H, double max_work, char *msg, size_t len)
+{
+    const double before = (double)cm->s.steps, after = before + floor(H / cm->h_max + 0.5);
+    const double work = contact_history_work(before, after);
+    char text[32];
+    if (!(work > max_work))
+        return 0;
+    snprintf(msg, len,
+             "memory = 1 (the full G1 history) is invalid for this advance from t = %.17g s: its %.3g steps of "
+             "dt_max = %s s would sum over up to %.3g steps each, the work of %.3g internal steps (one more per %d "
+             "summed), more than %.0e; use memory = 2, a larger dt_max, or shorter advances (communication steps)",
+             cm->s.t, after - before, shown(cm->h_max, text), after, work, CONTACT_HISTORY_PER_UNIT, max_work);
+    return -1;
+}
+
+int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len)
+{
+    double steps;
+    char text[64];
+    if (full_history(cm))
+        return check_history_work(cm, H, max_steps, msg, len);
+    if (!(H / cm->h_max > max_steps)) /* not even all of it in contact: the common case, known at once */
+        return 0;
+    steps = contact_least_steps(&cm->p, H, least_contact(cm, H));
+    if (!(steps > max_steps))
+        return 0;
+    snprintf(msg, len,
+             "%s is invalid for this advance from t = %.17g s: it would take at least %.3g internal steps of at most "
+             "%.3g s, more than %.0e; raise dt_max, or take shorter advances (communication steps)",
+             shown_step(&cm->p, text), cm->s.t, steps, cm->h_max, max_steps);
+    return -1;
 }
 
 /* The fixed step in the current contact: dt_max where it resolves the
