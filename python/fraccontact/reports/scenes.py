@@ -194,7 +194,12 @@ def document(head_rows, head_ref, head_runs, bumper_rows, bumper_ref, bumper_run
         "its striker's input F and +F on its second body's F2.",
         "",
         "Run one: `fraccontact scene headform --master fmpy|libcosim|container|container-gs|reference [--H ...] "
-        "[--headform child] [--gap0 ...]`, `fraccontact scene bumper [--v ...]`.",
+        "[--headform child] [--gap0 ...]`, `fraccontact scene bumper [--v ...]`. A run takes 3 steps of H at "
+        "least (the deceleration is the velocity's change over each step, and the CFC filter takes 3 samples). "
+        "A run whose `--t-end` comes before its contact (the skin, the fascia) has ended reports that contact in "
+        "`not_ended`, with a warning, and no duration or restitution (null); the head's HIC15 is then of a pulse "
+        "cut short, `HIC15_lower_bound`. HIC15 is searched on a grid no finer than 1e-5 s (`crash.HIC_STEP`): "
+        "at a finer H the filtered deceleration is interpolated onto it (docs/scenes_reference.md).",
         "",
         "In fmpy from Python: its `simulate_ssp` applies no SSV binding, and would run the FMUs' defaults (the "
         "head at rest, the contact the drop test's); `fraccontact.ssp.bound_parameters(ssp)` gathers the SSP's "

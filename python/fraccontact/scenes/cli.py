@@ -42,7 +42,8 @@ def parser(prog=None):
                    help="fmpy (default) | libcosim | container | container-gs (its sequential mode) | reference")
     p.add_argument("--H", type=positive, help=f"communication step [s] (default {STEP['headform']:g}; at most {H_MAX:g})")
     p.add_argument("--t-end", type=positive, help="simulated time [s] (default: headform "
-                   f"{T_END['headform']:g}, bumper {T_END['bumper']:g})")
+                   f"{T_END['headform']:g}, bumper {T_END['bumper']:g}; at least {MIN_STEPS} steps of H; before the "
+                   "contact ends: no duration, no restitution, HIC15 a lower bound)")
     p.add_argument("--headform", choices=HEADFORMS, help="headform: adult (4.5 kg, 11.1 m/s; default) | child")
     p.add_argument("--gap0", type=non_negative, help="headform: clearance to the hard point [m] (default 0.065)")
     p.add_argument("--k-p", type=positive, help="headform: the panel's bending stiffness [N/m]")
