@@ -97,8 +97,9 @@ def on_hic_grid(t, a_g):
 
 def figures(t, a, cfc=True):
     """The crash figures of one axis's acceleration a [m/s^2] sampled at t
-    [s]: HIC15, HIC36 and their windows (t1, t2) (searched on_hic_grid), the peak in g and its time,
-    the 3 ms clip in g (cumulative: the level exceeded for 3 ms in all).
+    [s]: HIC15, HIC36 and their windows (t1, t2), searched on_hic_grid; the
+    peak in g and its time, the 3 ms clip in g (cumulative: the level
+    exceeded for 3 ms in all), on every sample.
     cfc: through the CFC 1000 filter first (J211), as the protocols require."""
     t, a = record(t, a)
     a_g = in_g(filtered(t, a) if cfc else a)

@@ -155,8 +155,9 @@ def document(head_rows, head_ref, head_runs, bumper_rows, bumper_ref, bumper_run
              crossings):
     k = systems.CLEARANCE
     loan = bumper_runs["libcosim"]["energy_first"]
+    second = "(UN GTR 9's second limit)"
     published_clearance = {("adult", 1000.0): "about 70 mm (BASt bonnet study)", ("child", 1000.0): "about 50 mm (BASt)",
-                           ("adult", 1700.0): "(UN GTR 9's second limit)", ("child", 1700.0): "(UN GTR 9's second limit)"}
+                           ("adult", 1700.0): second, ("child", 1700.0): second}
     published = [
         "| figure | this model | published |", "|---|---|---|",
         *(f"| clearance for HIC15 = {limit:.0f}, {head} (libcosim; reference) | {cosim:.2f} mm; {ref:.2f} mm | "
