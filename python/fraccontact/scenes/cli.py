@@ -12,7 +12,7 @@ import sys
 import zipfile
 
 from ..options import OneLineParser, finite, positive
-from .masters import HEADFORMS, MASTERS, figures, grid, run
+from .masters import HEADFORMS, MASTERS, figures, grid, run, ssp_path
 from .systems import SCENES, STEP, T_END
 
 # A run's communication steps at most (fmpy's SSP master takes about 60 us a step per FMU).
@@ -66,6 +66,16 @@ def options_of(p, args):
     return {name: getattr(args, name) for name in own if getattr(args, name) is not None}
 
 
+def check_ssp(p, scene):
+    """The scene's SSP is there and a zip archive, or a usage error."""
+    try:
+        path = ssp_path(scene)
+    except FileNotFoundError as e:
+        p.error(str(e))
+    if not zipfile.is_zipfile(path):
+        p.error(f"{path} is not an SSP (a zip archive): rebuild it (scripts/build)")
+
+
 def main(argv=None, prog=None):
     p = parser(prog)
     args = p.parse_args(argv)
@@ -81,10 +91,12 @@ def main(argv=None, prog=None):
         p.error(f"--t-end {t_end:g} is invalid: at least {MIN_STEPS} steps of --H {H:g} s "
                 "(the deceleration's CFC filter takes 3 samples)")
     options = options_of(p, args)
+    if args.master != "reference":
+        check_ssp(p, args.name)
     try:
         trace = run(args.name, args.master, H, t_end, options)
         result = figures(trace, args.name, options)
-    except (ValueError, RuntimeError, OSError, zipfile.BadZipFile) as e:
+    except (ValueError, RuntimeError, OSError) as e:
         p.error(str(e).splitlines()[0])
     except KeyboardInterrupt:
         print(f"{p.prog}: interrupted", file=sys.stderr)
