@@ -210,7 +210,8 @@ def test_the_readme_fmi3_example_returns_where_it_says():
 
 BUILT = {"build/fraccontact.fmu": CONTACT, "build/fraccontact-fmi3.fmu": CONTACT.parent / "fraccontact-fmi3.fmu",
          "build/striker.fmu": pathlib.Path(os.environ.get("STRIKER_FMU", CONTACT.parent / "striker.fmu")),
-         "build/drop_test.ssp": pathlib.Path(os.environ.get("DROP_TEST_SSP", CONTACT.parent / "drop_test.ssp"))}
+         "build/drop_test.ssp": pathlib.Path(os.environ.get("DROP_TEST_SSP", CONTACT.parent / "drop_test.ssp")),
+         "build/headform.ssp": CONTACT.parent / "headform.ssp", "build/bumper.ssp": CONTACT.parent / "bumper.ssp"}
 PYTHON_BLOCKS = [(f"{page} {heading}", body) for page, heading, lang, body in all_blocks() if lang == "python"]
 
 

@@ -27,10 +27,11 @@ def ssp_path():
 
 
 def bound_parameters(ssp):
-    """The SSD's parameter bindings as one fmpy parameter set: fmpy's
-    simulate_ssp applies only a set it is given, and matches its names by
-    the component's path ("contact.scene"), where a binding names the
-    component's own variables ("scene")."""
+    """The parameter bindings of every component of the SSP ssp (a path) as
+    one fmpy parameter set, for simulate_ssp(ssp, ..., parameter_set=...):
+    fmpy applies no binding itself, only a set it is given, and matches its
+    names by the component's path ("contact.scene", "head.v0"), where a
+    binding names the component's own variables ("scene")."""
     from fmpy.ssp.ssd import ParameterSet, Parameter, find_components, read_ssd
     merged = ParameterSet(name="bindings")
     for component in find_components(read_ssd(str(ssp)).system):

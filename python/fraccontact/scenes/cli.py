@@ -9,15 +9,20 @@ import argparse
 import json
 import math
 import sys
+import zipfile
 
 from ..options import OneLineParser, finite, positive
-from .masters import HEADFORMS, MASTERS, figures, run
+from .masters import HEADFORMS, MASTERS, figures, grid, run, ssp_path
 from .systems import SCENES, STEP, T_END
 
 # A run's communication steps at most (fmpy's SSP master takes about 60 us a step per FMU).
 MAX_STEPS = 2_000_000
 # The CFC 1000 filter wants samples at 10 kHz at least: the head's deceleration is sampled every H.
 H_MAX = 1e-4
+# The deceleration is the velocity's change over each step, and the CFC filter takes 3 samples at least.
+MIN_STEPS = 3
+# What else a run cut short reports of the part it ran.
+LOWER_BOUND = {"headform": ", HIC15 a lower bound (HIC15_lower_bound)", "bumper": ""}
 HEADFORM_OPTIONS = ("headform", "gap0", "k_p", "c_p", "m_p")
 BUMPER_OPTIONS = ("v", "k_box", "zeta_box", "M", "m_b")
 
@@ -38,7 +43,8 @@ def parser(prog=None):
                         "(where installed, docs/ssp.md) | reference")
     p.add_argument("--H", type=positive, help=f"communication step [s] (default {STEP['headform']:g}; at most {H_MAX:g})")
     p.add_argument("--t-end", type=positive, help="simulated time [s] (default: headform "
-                   f"{T_END['headform']:g}, bumper {T_END['bumper']:g})")
+                   f"{T_END['headform']:g}, bumper {T_END['bumper']:g}; at least {MIN_STEPS} steps of H; before the "
+                   "contact ends: no duration, no restitution, HIC15 a lower bound)")
     p.add_argument("--headform", choices=HEADFORMS, help="headform: adult (4.5 kg, 11.1 m/s; default) | child")
     p.add_argument("--gap0", type=non_negative, help="headform: clearance to the hard point [m] (default 0.065)")
     p.add_argument("--k-p", type=positive, help="headform: the panel's bending stiffness [N/m]")
@@ -61,6 +67,16 @@ def options_of(p, args):
     return {name: getattr(args, name) for name in own if getattr(args, name) is not None}
 
 
+def check_ssp(p, scene):
+    """The scene's SSP is there and a zip archive, or a usage error."""
+    try:
+        path = ssp_path(scene)
+    except FileNotFoundError as e:
+        p.error(str(e))
+    if not zipfile.is_zipfile(path):
+        p.error(f"{path} is not an SSP (a zip archive): rebuild it (scripts/build)")
+
+
 def main(argv=None, prog=None):
     p = parser(prog)
     args = p.parse_args(argv)
@@ -72,12 +88,23 @@ def main(argv=None, prog=None):
         p.error(f"--H {H:g} is invalid: longer than --t-end {t_end:g} s")
     if t_end / H > MAX_STEPS:
         p.error(f"--t-end {t_end:g} in steps of --H {H:g} is {t_end / H:.3g} steps: at most {MAX_STEPS:.0e}")
+    if len(grid(H, t_end)) <= MIN_STEPS:
+        p.error(f"--t-end {t_end:g} is invalid: at least {MIN_STEPS} steps of --H {H:g} s "
+                "(the deceleration's CFC filter takes 3 samples)")
     options = options_of(p, args)
+    if args.master != "reference":
+        check_ssp(p, args.name)
     try:
         trace = run(args.name, args.master, H, t_end, options)
         result = figures(trace, args.name, options)
-    except (ValueError, RuntimeError) as e:
+    except (ValueError, RuntimeError, OSError) as e:
         p.error(str(e).splitlines()[0])
+    except KeyboardInterrupt:
+        print(f"{p.prog}: interrupted", file=sys.stderr)
+        return 130
+    for contact in result["not_ended"]:
+        print(f"{p.prog}: warning: the {contact} contact had not ended by --t-end {t_end:g} s: duration and "
+              f"restitution are null{LOWER_BOUND[args.name]}", file=sys.stderr)
     result = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in result.items()}
     print(json.dumps(dict(scene=args.name, master=args.master, H=H, t_end=t_end, options=options, **result)))
     return 0

@@ -15,10 +15,10 @@ F_avg_next (docs/coupling.md).
 """
 
 import contextlib
+import io
 import logging
 import pathlib
 import shutil
-import sys
 import tempfile
 
 from fmpy import simulate_fmu
@@ -83,8 +83,15 @@ def simulate(ssp, H, t_end, start, outputs, sequential=False):
     communication step H; sequential: in Gauss-Seidel order."""
     with tempfile.TemporaryDirectory() as folder:
         fmu = build(pathlib.Path(ssp), H, start, outputs, folder, sequential)
-        # fmpy prints the container's log (its mode, its solver's setup) on stdout, which is the
-        # command's: to stderr. (A logger of our own would outlive the call in fmpy's proxy.)
-        with contextlib.redirect_stdout(sys.stderr):
-            rows = simulate_fmu(str(fmu), stop_time=t_end, step_size=H, output_interval=H, output=list(outputs))
+        # fmpy prints the container's log on stdout, which is the command's. On every run the
+        # container logs its version, its mode and "Solver configure....", the last with status
+        # Error though nothing failed (toolbox 2.0's container_configure sends it unconditionally):
+        # the log is kept for a run that fails, whose error it ends. (A logger of our own would
+        # outlive the call in fmpy's proxy.)
+        log = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(log):
+                rows = simulate_fmu(str(fmu), stop_time=t_end, step_size=H, output_interval=H, output=list(outputs))
+        except Exception as e:
+            raise RuntimeError(f"the container FMU failed: {e}\nits log:\n{log.getvalue()}") from e
     return {name: rows[name].astype(float) for name in outputs}

@@ -225,6 +225,12 @@ def contact_duration(trace, contact):
     return float(t[min(on[-1] + 1, len(t) - 1)] - t[max(on[0] - 1, 0)])
 
 
+def ended(trace, contact):
+    """Whether the contact has been on and is off (F = 0) at the trace's end."""
+    F = trace[f"{contact}.F"]
+    return bool(np.any(F > 0) and F[-1] <= 0)
+
+
 def stored(trace, contact, k):
     """The energy in a contact's Hertz spring, k x1^(n+1)/(n+1) [J]."""
     return k * np.maximum(trace[f"{contact}.x1"], 0.0) ** (HERTZ_N + 1) / (HERTZ_N + 1)
@@ -259,24 +265,32 @@ def figures(trace, scene, options=None):
     (-momentum at the end / (M + m_b) v), momentum_error (the momentum lost
     against the barrier's impulse). Both: energy_error, the balance at the
     end; energy_first, after the first step; energy_max, its largest from the
-    second step on."""
+    second step on; not_ended, the contact (skin, fascia) when it has not
+    ended by the trace's end: its duration and restitution are then None,
+    and HIC15_lower_bound says that the head's pulse was cut short."""
     start = values(scene, options)
     energy = balance(trace, scene, start)
     energies = dict(energy_error=float(energy[-1]), energy_first=float(energy[1]), energy_max=float(energy[2:].max()))
     if scene == "headform":
         head = start["head"]
         f = crash.figures(*deceleration(trace, "head"))
-        return dict(HIC15=f["HIC15"], HIC15_window=f["HIC15_window"], peak_g=f["peak_g"], clip3ms_g=f["clip3ms_g"],
+        over = ended(trace, "skin")
+        return dict(HIC15=f["HIC15"], HIC15_lower_bound=not over, HIC15_window=f["HIC15_window"],
+                    peak_g=f["peak_g"], clip3ms_g=f["clip3ms_g"],
                     panel_deflection=float(trace["panel.x"].max()), head_travel=float(trace["head.x"].max()),
-                    duration=contact_duration(trace, "skin"), restitution=float(-trace["head.v"][-1] / head["v0"]),
-                    **energies)
+                    duration=contact_duration(trace, "skin") if over else None,
+                    restitution=float(-trace["head.v"][-1] / head["v0"]) if over else None,
+                    not_ended=[] if over else ["skin"], **energies)
     vehicle = start["vehicle"]
     M, m, v = vehicle["m_a"], vehicle["m"], vehicle["v0"]
     _, a = deceleration(trace, "vehicle", "v_a")
     t, F = trace["t"], trace["fascia.F"]
     p = M * trace["vehicle.v_a"] + m * trace["vehicle.v"]
     impulse = np.concatenate([[0.0], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t))])
+    over = ended(trace, "fascia")
     return dict(F_peak=float(F.max()), crush=float(trace["vehicle.x_a"].max()),
                 peak_g=float(np.max(np.abs(a)) / crash.STANDARD_GRAVITY),
-                duration=contact_duration(trace, "fascia"), restitution=float(-p[-1] / ((M + m) * v)),
-                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)), **energies)
+                duration=contact_duration(trace, "fascia") if over else None,
+                restitution=float(-p[-1] / ((M + m) * v)) if over else None,
+                momentum_error=float((p[-1] - p[0] + impulse[-1]) / ((M + m) * v)),
+                not_ended=[] if over else ["fascia"], **energies)
