@@ -62,6 +62,7 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
+    cm->method = contact_method(p);
     cm->error_controlled = contact_error_controlled(p);
     cm->h_max = contact_step_limit(p);
     resolve_contact(cm);
@@ -93,10 +94,27 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
     contact_start_with(cm, p, v0, m, NULL);
 }
 
+/* Clears a model but for the springpot's arrays, whose part a run uses
+ * configure and contact_start_with fill: its modes, padded to whole lanes
+ * (as contact_copy copies them). All of them are most of a short run's
+ * work to clear, and most of them a run with few modes, or none, never
+ * touches. */
+static void clear_model(contact_model *cm)
+{
+    contact_modes *m = &cm->modes;
+    memset(cm, 0, offsetof(contact_model, modes));
+    m->modes = 0;
+    m->eta = m->h = m->sum_p = m->sum_q = m->radau_h = 0.0;
+    memset(&cm->history, 0, sizeof cm->history);
+}
+
 void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
 {
-    memset(cm, 0, sizeof *cm);
+    clear_model(cm);
     configure(cm, p, kernel);
+    /* the memory at rest (pad_modes zeroed the padding) */
+    memset(cm->modes.phi, 0, (cm->modes.modes < CONTACT_MAX_MODES ? cm->modes.modes : CONTACT_MAX_MODES)
+                                 * sizeof cm->modes.phi[0]);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
@@ -172,7 +190,8 @@ int contact_never_returns(const contact_model *cm)
 int contact_rests(const contact_model *cm)
 {
     const contact_state *s = &cm->s;
-    return s->in_contact && !springpot(cm) && cm->accel == 0.0 && s->F <= DBL_EPSILON * s->F_peak_contact
+    /* the force's test first: every step in contact asks, and it fails while the force lasts */
+    return s->in_contact && s->F <= DBL_EPSILON * s->F_peak_contact && !springpot(cm) && cm->accel == 0.0
            && fabs(s->v) <= DBL_EPSILON * fabs(s->v_onset);
 }
 
