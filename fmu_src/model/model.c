@@ -108,13 +108,26 @@ static void clear_model(contact_model *cm)
     memset(&cm->history, 0, sizeof cm->history);
 }
 
+/* The memory at rest (pad_modes zeroed the padding), and the coefficients
+ * of no step length zero as in a model cleared whole: modes.h = 0 names
+ * none, but a step of length 0 (a flight that touches at once) reads them
+ * as they are. */
+static void modes_at_rest(contact_modes *m)
+{
+    const size_t bytes = (m->modes < CONTACT_MAX_MODES ? m->modes : CONTACT_MAX_MODES) * sizeof m->phi[0];
+    memset(m->phi, 0, bytes);
+    memset(m->p, 0, bytes);
+    memset(m->q, 0, bytes);
+    memset(m->keep, 0, bytes);
+    memset(m->rate1, 0, bytes);
+    memset(m->rate2, 0, bytes);
+}
+
 void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
 {
     clear_model(cm);
     configure(cm, p, kernel);
-    /* the memory at rest (pad_modes zeroed the padding) */
-    memset(cm->modes.phi, 0, (cm->modes.modes < CONTACT_MAX_MODES ? cm->modes.modes : CONTACT_MAX_MODES)
-                                 * sizeof cm->modes.phi[0]);
+    modes_at_rest(&cm->modes);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
