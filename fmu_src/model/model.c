@@ -60,9 +60,9 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
+    cm->method = contact_method(p);
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
-    cm->method = contact_method(p);
     cm->error_controlled = contact_error_controlled(p);
     cm->h_max = contact_step_limit(p);
     resolve_contact(cm);
