@@ -49,10 +49,11 @@ def read_record():
 
 
 def toolchain_of(compiler):
-    """The C compiler's version and the C library's."""
+    """The C compiler's version and the C library's (less the names they were
+    called by: cc and gcc are one compiler)."""
     version = subprocess.run([compiler, "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     libc = subprocess.run(["ldd", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
-    return f"{version}; {libc}"
+    return f"{version.partition(' ')[2] or version}; {libc.partition(' ')[2] or libc}"
 
 
 def counted(argv):
