@@ -355,6 +355,7 @@ typedef struct {
     int history;        /* whether they sum over the full G1 history */
     int64_t work, next; /* work done so far, and where the next call falls */
     int stopped;        /* the callback asked to stop */
+    int64_t poll_at;    /* the model's step count at which the run asks again */
 } watch;
 
 static int stop_asked(watch *w, int64_t extra);
@@ -370,6 +371,7 @@ static void watch_run(watch *w, contact_model *cm)
 {
     w->cm = cm;
     w->counted = 0;
+    w->poll_at = 0;
     w->unit = contact_error_controlled(&cm->p) ? CONTROLLED_STEP_UNITS : 1;
     w->history = contact_method(&cm->p) == CONTACT_METHOD_G1_HISTORY;
     if (w->report) {
@@ -397,7 +399,17 @@ static int stop_asked(watch *w, int64_t extra)
         w->next = w->work + PROGRESS_WORK;
         w->stopped = w->stopped || w->report(w->ctx, cm->s.t, cm->s.steps, cm->s.impacts) != 0;
     }
+    /* the steps whose work reaches the next call; the full G1 history's
+     * grow dearer, so it asks after each */
+    w->poll_at = cm->s.steps + (w->history ? 1 : (w->next - w->work + w->unit - 1) / w->unit);
     return w->stopped;
+}
+
+/* Whether the run's loop asks stop_asked after a step: only where its
+ * callback may be due, not at every step. */
+static int stop_due(const watch *w)
+{
+    return w->report && (w->stopped || w->cm->s.steps >= w->poll_at);
 }
 
 /* The model's state as a row of the time series. */
@@ -588,7 +600,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
             if (out->failed)
                 break;
         }
-        if (stop_asked(w, 0)) {
+        if (stop_due(w) && stop_asked(w, 0)) {
             snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", cm.s.t);
             return finish(&cm, o, FC_ESTOPPED);
         }
@@ -606,7 +618,7 @@ fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_pr
 {
     series rows = {NULL, 0, 0, 0};
     impact_list impacts = {NULL, 0, 0};
-    watch w = {progress, ctx, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0};
+    watch w = {progress, ctx, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0, 0};
     fc_status status;
     double interval = output_interval == FC_DEFAULT_ROWS ? fc_default_output_interval(p) : output_interval;
     memset(r, 0, sizeof *r);
@@ -654,7 +666,7 @@ fc_status fc_run_batch_with_progress(size_t n, const fc_params *params, fc_outco
 {
     char why[FC_MESSAGE_SIZE];
     batch_watch b = {progress, ctx, 0, n};
-    watch w = {progress ? batch_progress : NULL, &b, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0};
+    watch w = {progress ? batch_progress : NULL, &b, NULL, 0, 1, 0, 0, PROGRESS_WORK, 0, 0};
     fc_status first = FC_OK, status = FC_OK;
     contact_kernel kernel; /* runs alike share their springpot's kernel */
     size_t i;

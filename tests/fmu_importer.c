@@ -4,7 +4,10 @@
  * 10 us) and prints the results with every digit. Built for Linux and for
  * Windows, so that the test windows_matches_linux can compare the two
  * binaries through their exported functions alone, as a user's tool sees them.
- *   fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll}  */
+ * REPEATS runs the experiment that many times, each in a new instance, and
+ * prints the last one's results (tests/instruction_counts.py counts a run's
+ * instructions as the difference of two such counts).
+ *   fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS]  */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,50 +73,62 @@ static void ok(fmi2Status status, const char *call)
 
 #define LOAD(name) ((name##TYPE *)load(binary, #name))
 
-int main(int argc, char **argv)
+#define STOP 3e-3
+#define H 1e-5
+#define OUTPUTS 5
+
+/* The default experiment in a new instance: the outputs at its end, the
+ * impulse of F_avg, and the first and the last communication point in
+ * contact (-1: none). */
+static void experiment(const char *binary, double end[OUTPUTS], double *impulse, double *t_first, double *t_last)
 {
     const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
-    const double stop = 3e-3, h = 1e-5;
     const fmi2ValueReference vr_F_avg = VR_F_avg, vr_contact = VR_contact;
-    const fmi2ValueReference vr_end[] = {VR_F_peak, VR_eps, VR_E_diss, VR_x2, VR_v_striker};
-    const char *names[] = {"F_peak", "eps", "E_diss", "x2", "v_striker"};
-    const char *binary;
-    double end[sizeof vr_end / sizeof vr_end[0]], impulse = 0.0, t_first = -1.0, t_last = -1.0;
-    long i, steps = (long)(stop / h + 0.5);
-    size_t k;
-    fmi2Component c;
-
-    if (argc != 2) {
-        fprintf(stderr, "usage: fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll}\n");
-        return 2;
-    }
-    binary = argv[1];
-    c = LOAD(fmi2Instantiate)("importer", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
+    const fmi2ValueReference vr_end[OUTPUTS] = {VR_F_peak, VR_eps, VR_E_diss, VR_x2, VR_v_striker};
+    long i, steps = (long)(STOP / H + 0.5);
+    fmi2Component c = LOAD(fmi2Instantiate)("importer", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False,
+                                            fmi2False);
     if (!c) {
         fprintf(stderr, "fmu_importer: fmi2Instantiate failed\n");
-        return 1;
+        exit(1);
     }
-    ok(LOAD(fmi2SetupExperiment)(c, fmi2False, 0.0, 0.0, fmi2True, stop), "fmi2SetupExperiment");
+    *impulse = 0.0;
+    *t_first = *t_last = -1.0;
+    ok(LOAD(fmi2SetupExperiment)(c, fmi2False, 0.0, 0.0, fmi2True, STOP), "fmi2SetupExperiment");
     ok(LOAD(fmi2EnterInitializationMode)(c), "fmi2EnterInitializationMode");
     ok(LOAD(fmi2ExitInitializationMode)(c), "fmi2ExitInitializationMode");
     for (i = 0; i < steps; i++) {
-        double t = (double)i * h, F_avg;
+        double t = (double)i * H, F_avg;
         fmi2Boolean contact;
-        ok(LOAD(fmi2DoStep)(c, t, h, fmi2True), "fmi2DoStep");
+        ok(LOAD(fmi2DoStep)(c, t, H, fmi2True), "fmi2DoStep");
         ok(LOAD(fmi2GetReal)(c, &vr_F_avg, 1, &F_avg), "fmi2GetReal");
         ok(LOAD(fmi2GetBoolean)(c, &vr_contact, 1, &contact), "fmi2GetBoolean");
-        impulse += F_avg * h;
+        *impulse += F_avg * H;
         if (contact) {
-            if (t_first < 0.0)
-                t_first = t + h;
-            t_last = t + h;
+            if (*t_first < 0.0)
+                *t_first = t + H;
+            *t_last = t + H;
         }
     }
-    ok(LOAD(fmi2GetReal)(c, vr_end, sizeof vr_end / sizeof vr_end[0], end), "fmi2GetReal");
+    ok(LOAD(fmi2GetReal)(c, vr_end, OUTPUTS, end), "fmi2GetReal");
     ok(LOAD(fmi2Terminate)(c), "fmi2Terminate");
     LOAD(fmi2FreeInstance)(c);
+}
 
-    for (k = 0; k < sizeof end / sizeof end[0]; k++)
+int main(int argc, char **argv)
+{
+    const char *names[OUTPUTS] = {"F_peak", "eps", "E_diss", "x2", "v_striker"};
+    double end[OUTPUTS], impulse, t_first, t_last;
+    long repeats = argc == 3 ? atol(argv[2]) : 1, r;
+    size_t k;
+
+    if ((argc != 2 && argc != 3) || repeats < 1) {
+        fprintf(stderr, "usage: fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS]\n");
+        return 2;
+    }
+    for (r = 0; r < repeats; r++)
+        experiment(argv[1], end, &impulse, &t_first, &t_last);
+    for (k = 0; k < OUTPUTS; k++)
         printf("%s %.17g\n", names[k], end[k]);
     printf("impulse %.17g\nt_contact_first %.17g\nt_contact_last %.17g\n", impulse, t_first, t_last);
     return 0;

@@ -533,6 +533,40 @@ static void test_a_copy_steps_as_its_original(void)
           "a copy's step (%zu modes) is its original's: x1 %.17g and %.17g", cm.modes.modes, copied.x1, original.x1);
 }
 
+/* A model started on memory that held anything (here every byte 0xff,
+ * NaN) runs as one started on zeros, to the bit: contact_start clears only
+ * what a run uses of the springpot's arrays, and the flight of a striker
+ * that touches at once is a step of length 0, which reads the coefficients
+ * of no step length as they are. Both the fixed and the error-controlled
+ * springpot, the whole impact. */
+static void test_a_start_on_any_memory_runs_as_on_zeros(void)
+{
+    static contact_model dirty, clean;
+    double tolerances[] = {0.0, 1e-8};
+    int i;
+    for (i = 0; i < 2; i++) {
+        contact_params p;
+        double v0, m;
+        contact_default_params(&p);
+        contact_default_striker(&v0, &m);
+        p.law = CONTACT_LAW_HERTZ;
+        p.damper = CONTACT_DAMPER_SPRINGPOT;
+        p.tolerance = tolerances[i];
+        memset(&dirty, 0xff, sizeof dirty);
+        memset(&clean, 0, sizeof clean);
+        contact_start(&dirty, &p, v0, m);
+        contact_start(&clean, &p, v0, m);
+        while (clean.s.impacts == 0 && clean.s.t < 3e-3) {
+            contact_advance(&clean, 1e-5);
+            contact_advance(&dirty, 1e-5);
+        }
+        CHECK(clean.s.impacts == 1 && memcmp(&dirty.s, &clean.s, offsetof(contact_state, step)) == 0
+                  && memcmp(dirty.modes.phi, clean.modes.phi, clean.modes.modes * sizeof clean.modes.phi[0]) == 0,
+              "tolerance %g: a start on 0xff bytes runs as on zeros (F_peak %.17g and %.17g)", tolerances[i],
+              dirty.s.F_peak, clean.s.F_peak);
+    }
+}
+
 /* contact_check_params counts a springpot's modes only below
  * CONTACT_MEMORY_FLOOR: at the floor every alpha and memory_tolerance fits
  * CONTACT_MAX_MODES (and a higher floor needs fewer). Checked here over
@@ -616,6 +650,7 @@ int main(void)
     test_radau_modes_are_the_last_stage();
     test_radau_dense_output_interpolates();
     test_a_copy_steps_as_its_original();
+    test_a_start_on_any_memory_runs_as_on_zeros();
     test_radau_same_bits_at_every_vector_width();
     test_kernels_above_the_floor_fit();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);

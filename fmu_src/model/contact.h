@@ -132,14 +132,18 @@ typedef struct {
     int64_t impacts;  /* finished impacts */
     double h_next;    /* the error control's next step (tolerance > 0; 0: none yet) */
     int in_contact;
+    double x2_rate;   /* the damper's rate x2' at the end of the last internal step (the springpot's memory
+                         saves it, not the list below) [m/s] */
     /* Not part of the state carried from step to step (so not listed
-     * below): what a trial step leaves for accepting it, its length and
-     * the damper's rate x2' at its stages (the last is the end's), and an
-     * error-controlled step's error over the tolerance: SDIRK2's two
-     * stages in x2_rate1 and x2_rate, a springpot's Radau IIA step's five
-     * in x2_rate1, x2_rate_inner and x2_rate, and its elastic indentations
-     * at the first four stages (x1 is the fifth's) for its dense output. */
-    double step, x2_rate1, x2_rate, error;
+     * below, and not copied from one state to the next: the fields above
+     * are, contact_internal.h's carry_state): what a trial step leaves for
+     * accepting it, its length and the damper's rate x2' at its stages
+     * before the last (x2_rate is the end's), and an error-controlled
+     * step's error over the tolerance: SDIRK2's two stages in x2_rate1 and
+     * x2_rate, a springpot's Radau IIA step's five in x2_rate1,
+     * x2_rate_inner and x2_rate, and its elastic indentations at the first
+     * four stages (x1 is the fifth's) for its dense output. */
+    double step, x2_rate1, error;
     double x2_rate_inner[3], x1_inner[4];
 } contact_state;
 
@@ -186,6 +190,7 @@ typedef struct {
     double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
+    enum contact_method method; /* contact_method(&p) */
     int error_controlled;   /* tolerance > 0 where it applies: error-controlled steps */
     double series_limit;    /* an implicit stage's root is its series while (beta^2 r) is below this (stage_root):
                                its error, 20 u^7, is then within 1e-3 of the tolerance; 0: to rounding */

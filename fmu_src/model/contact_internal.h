@@ -5,6 +5,8 @@
 #define FRACCONTACT_CONTACT_INTERNAL_H
 
 #include <math.h>
+#include <stddef.h>
+#include <string.h>
 
 #include "contact.h"
 #include "g1.h"
@@ -25,8 +27,10 @@ int memory_at_rest(const contact_model *cm);
 
 /* sdirk2.c, esdirk54.c and radau_iia.c: one step of length h from *in
  * with spring stiffness K into *out, returning the contact force's
- * impulse; the compressed memory after an accepted step. */
-double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+ * impulse (sdirk_step below, by the damper); the compressed memory after
+ * an accepted step. */
+double sdirk_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void advance_modes(contact_model *cm, double h, double z1, double z2);
 double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
@@ -77,6 +81,13 @@ static inline int springpot(const contact_model *cm) { return cm->p.damper == CO
 static inline int compressed_memory(const contact_model *cm)
 {
     return springpot(cm) && cm->p.memory == CONTACT_MEMORY_COMPRESSED;
+}
+
+/* SDIRK2's step (sdirk2.c), the damper's own: inline, so that the fixed
+ * steps call the one they take. */
+static inline double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    return springpot(cm) ? sdirk_springpot_step(cm, in, h, K, out) : sdirk_dashpot_step(cm, in, h, K, out);
 }
 
 static inline int full_history(const contact_model *cm)
@@ -164,6 +175,14 @@ static inline void count_contact_step(contact_state *s, double peak)
         s->F_peak = peak;
 }
 
+/* Copies the part of a state carried from step to step, the fields up to
+ * x2_rate (contact.h): a trial's own fields after it are read off the
+ * trial alone, so no step copies them. */
+static inline void carry_state(contact_state *to, const contact_state *from)
+{
+    memcpy(to, from, offsetof(contact_state, step));
+}
+
 /* Makes a trial step the model's state, and its memory follow. */
 static inline void accept_step(contact_model *cm, const contact_state *trial)
 {
@@ -173,7 +192,7 @@ static inline void accept_step(contact_model *cm, const contact_state *trial)
         else
             advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
     }
-    cm->s = *trial;
+    carry_state(&cm->s, trial);
 }
 
 #endif

@@ -71,7 +71,7 @@ double esdirk_step(contact_model *cm, const contact_state *in, double h, double 
         impulse += h * esdirk_a[last][j] * F[j];
         work += h * esdirk_a[last][j] * F[j] * F[j];
     }
-    *out = *in;
+    carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X;
     out->v = V;

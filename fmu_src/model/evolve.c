@@ -127,20 +127,52 @@ static int internal_step(contact_model *cm, enum contact_method method, double h
     return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
-static int state_is_finite(const contact_model *cm)
+/* Whether every value of the state is finite, one by one. */
+static int each_is_finite(const contact_model *cm)
 {
     const contact_state *s = &cm->s;
     size_t i;
 #define FINITE(field) &&isfinite(s->field)
-#define ALWAYS_FINITE(field)
-    if (!(1 CONTACT_STATE_FIELDS(FINITE, ALWAYS_FINITE, ALWAYS_FINITE) && isfinite(s->x2_rate)))
+#define NOT_DOUBLE(field)
+    if (!(1 CONTACT_STATE_FIELDS(FINITE, NOT_DOUBLE, NOT_DOUBLE) && isfinite(s->x2_rate)))
         return 0;
 #undef FINITE
-#undef ALWAYS_FINITE
     for (i = 0; i < cm->modes.modes; i++)
         if (!isfinite(cm->modes.phi[i]))
             return 0;
     return 1;
+}
+
+/* Whether every value of the state is finite: their sum is where each is
+ * (an infinity or a NaN stays in a sum), an add a value; only a sum that
+ * is not, which finite values may also give by overflowing, asks them one
+ * by one. */
+static inline int state_is_finite(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    double sum = s->x2_rate;
+    size_t i;
+#define ADD(field) sum += s->field;
+    CONTACT_STATE_FIELDS(ADD, NOT_DOUBLE, NOT_DOUBLE)
+#undef ADD
+#undef NOT_DOUBLE
+    for (i = 0; i < cm->modes.modes; i++)
+        sum += cm->modes.phi[i];
+    return isfinite(sum) || each_is_finite(cm);
+}
+
+/* How many equal steps of at most dt_max (or what resolves the impact)
+ * cover the rest of an advance: n rounded up but forgiving the last few
+ * ulp of the step and of the clock (H = n dt_max gives n steps, not n + 1
+ * with a sliver, also when a master computes H as t_next - t, which errs
+ * by an ulp of t). A rest no longer than one step is one, as the rounding
+ * gives too: the library's pieces of dt_max take it at every step. */
+static inline double equal_steps(const contact_model *cm, double remaining)
+{
+    if (remaining <= cm->contact_step)
+        return 1.0;
+    return larger(ceil((remaining - 4.0 * DBL_EPSILON * fabs(cm->s.t + remaining)) / cm->contact_step * (1.0 - 1e-12)),
+                  1.0);
 }
 
 double contact_advance(contact_model *cm, double H)
@@ -150,15 +182,16 @@ double contact_advance(contact_model *cm, double H)
 
 double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
 {
-    const contact_state start = cm->s;
-    const int64_t allowed = cm->max_steps > 0 ? start.steps + cm->max_steps : INT64_MAX;
+    contact_state start;
+    const int64_t allowed = cm->max_steps > 0 ? cm->s.steps + cm->max_steps : INT64_MAX;
     double phi_start[CONTACT_MAX_MODES];
     double remaining = H, impulse = 0.0;
-    const enum contact_method method = contact_method(&cm->p);
+    const enum contact_method method = cm->method;
     const int uniform = method == CONTACT_METHOD_G1_HISTORY || method == CONTACT_METHOD_CENTRAL;
     int stopped = 0, failed = 0, exceeded = 0;
     if (!(H > 0.0))
         return 0.0;
+    carry_state(&start, &cm->s);
     if (compressed_memory(cm))
         memcpy(phi_start, cm->modes.phi, cm->modes.modes * sizeof *phi_start);
     while (remaining > 0.0 && !stopped && !failed) {
@@ -198,14 +231,9 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
             remaining = advanced < remaining ? remaining - advanced : 0.0;
             continue;
         }
-        /* In contact: equal steps of at most dt_max (or what resolves the
-         * impact) over the rest, rounding n up but forgiving the last few ulp
-         * of the step and of the clock (H = n dt_max gives n steps, not n + 1
-         * with a sliver, also when a master computes H as t_next - t, which
-         * errs by an ulp of t), until the contact ends or the steps allowed
-         * run out. */
-        n = fmax(1.0, ceil((remaining - 4.0 * DBL_EPSILON * fabs(cm->s.t + remaining)) / cm->contact_step *
-                           (1.0 - 1e-12)));
+        /* In contact: equal steps over the rest, until the contact ends or
+         * the steps allowed run out. */
+        n = equal_steps(cm, remaining);
         h = remaining / n;
         steps = smaller(n, (double)(allowed - cm->s.steps));
         for (i = 0; i < steps && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
@@ -219,7 +247,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
      * (and bounds their event searches), so one check at the end suffices. */
     if (failed || !state_is_finite(cm)) {
         cm->exceeded = exceeded;
-        cm->s = start;
+        carry_state(&cm->s, &start);
         if (compressed_memory(cm))
             memcpy(cm->modes.phi, phi_start, cm->modes.modes * sizeof *phi_start);
         return NAN;

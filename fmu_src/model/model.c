@@ -60,6 +60,7 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
+    cm->method = contact_method(p);
     /* An error-controlled step needs its stages' roots well inside its
      * tolerance, not to rounding. */
     cm->error_controlled = contact_error_controlled(p);
@@ -93,10 +94,40 @@ void contact_start(contact_model *cm, const contact_params *p, double v0, double
     contact_start_with(cm, p, v0, m, NULL);
 }
 
+/* Clears a model but for the springpot's arrays, whose part a run uses
+ * configure and contact_start_with fill: its modes, padded to whole lanes
+ * (as contact_copy copies them). All of them are most of a short run's
+ * work to clear, and most of them a run with few modes, or none, never
+ * touches. */
+static void clear_model(contact_model *cm)
+{
+    contact_modes *m = &cm->modes;
+    memset(cm, 0, offsetof(contact_model, modes));
+    m->modes = 0;
+    m->eta = m->h = m->sum_p = m->sum_q = m->radau_h = 0.0;
+    memset(&cm->history, 0, sizeof cm->history);
+}
+
+/* The memory at rest (pad_modes zeroed the padding), and the coefficients
+ * of no step length zero as in a model cleared whole: modes.h = 0 names
+ * none, but a step of length 0 (a flight that touches at once) reads them
+ * as they are. */
+static void modes_at_rest(contact_modes *m)
+{
+    const size_t bytes = (m->modes < CONTACT_MAX_MODES ? m->modes : CONTACT_MAX_MODES) * sizeof m->phi[0];
+    memset(m->phi, 0, bytes);
+    memset(m->p, 0, bytes);
+    memset(m->q, 0, bytes);
+    memset(m->keep, 0, bytes);
+    memset(m->rate1, 0, bytes);
+    memset(m->rate2, 0, bytes);
+}
+
 void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
 {
-    memset(cm, 0, sizeof *cm);
+    clear_model(cm);
     configure(cm, p, kernel);
+    modes_at_rest(&cm->modes);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
     if (p->scene == CONTACT_SCENE_DROP) {
@@ -179,7 +210,8 @@ int contact_flight_arrives(double x1, double v, double a)
 int contact_rests(const contact_model *cm)
 {
     const contact_state *s = &cm->s;
-    return s->in_contact && !springpot(cm) && cm->accel == 0.0 && s->F <= DBL_EPSILON * s->F_peak_contact
+    /* the force's test first: every step in contact asks, and it fails while the force lasts */
+    return s->in_contact && s->F <= DBL_EPSILON * s->F_peak_contact && !springpot(cm) && cm->accel == 0.0
            && fabs(s->v) <= DBL_EPSILON * fabs(s->v_onset);
 }
 

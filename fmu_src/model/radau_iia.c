@@ -407,7 +407,7 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     }
     for (i = 0; i < STAGES; i++)
         X[i] = x1 + radau_c[i] * h * slide;
-    *out = *in;
+    carry_state(out, in);
     out->t = in->t + h;
     out->step = h;
     if (!stage_indentations(cm, K, mu, rho, xi, X, F)) {

@@ -83,8 +83,8 @@ void advance_modes(contact_model *cm, double h, double z1, double z2)
  * contact: free flight, exact while the damper rests). Writes t, x1, x2, v,
  * F, E_diss and what accepting the step needs (its length and the damper's
  * stage rates) of *out; returns the impulse of the contact force. Inlined
- * twice below, so that the dashpot's copy carries none of the springpot's
- * work: `springpot` and `compressed` are constants in each. */
+ * in the dashpot's and the springpot's steps below, so that the dashpot's
+ * carries none of the springpot's work: `springpot` is a constant in each. */
 static inline double sdirk_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
                                    const int springpot, const int compressed)
 {
@@ -103,7 +103,7 @@ static inline double sdirk_step_of(contact_model *cm, const contact_state *in, d
     z2 = (F2 - d2.A) * d2.inv_B;
     impulse = hb * F1 + hg * F2;
 
-    *out = *in;
+    carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X2;
     out->v = V2;
@@ -128,9 +128,12 @@ static inline double sdirk_step_of(contact_model *cm, const contact_state *in, d
     return impulse;
 }
 
-double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+double sdirk_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    if (!springpot(cm))
-        return sdirk_step_of(cm, in, h, K, out, 0, 0);
+    return sdirk_step_of(cm, in, h, K, out, 0, 0);
+}
+
+double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
     return sdirk_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }

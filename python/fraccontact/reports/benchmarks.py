@@ -28,6 +28,7 @@ Regenerate: scripts/report benchmarks   (about 20 minutes)
             scripts/report benchmarks --only precision   (section 2 alone, in place)
             scripts/report benchmarks --only package     (section 4 alone, in place)
             scripts/report benchmarks --only springpot   (section 5 alone, in place)
+            scripts/report benchmarks --only instructions  (the instruction counts alone, in place)
 """
 
 import contextlib
@@ -787,21 +788,21 @@ def git(root, *args):
 
 
 @contextlib.contextmanager
-def base_build(root, commit):
-    """fraccontact-bench and the FMU of `commit`, built (Release) in a
-    temporary git worktree, which is removed afterwards."""
+def base_build(root, commit, targets=("fraccontact-bench", "fraccontact_fmu")):
+    """The targets (by default fraccontact-bench and the FMU) of `commit`,
+    built (Release) in a temporary git worktree, which is removed afterwards."""
     folder = pathlib.Path(tempfile.mkdtemp(prefix="fraccontact-base-"))
     tree, build = folder / "tree", folder / "build"
     git(root, "worktree", "add", "--detach", str(tree), commit)
     try:
         for command in (["cmake", "-S", tree, "-B", build, "-DCMAKE_BUILD_TYPE=Release",
                          f"-DPython3_EXECUTABLE={sys.executable}"],
-                        ["cmake", "--build", build, "-j2", "--target", "fraccontact-bench", "fraccontact_fmu"]):
+                        ["cmake", "--build", build, "-j2", "--target", *targets]):
             done = subprocess.run([str(c) for c in command], capture_output=True, text=True)
             if done.returncode != 0:
                 raise SystemExit(f"{' '.join(map(str, command))} failed:\n{done.stdout[-3000:]}{done.stderr[-3000:]}")
         yield dict(tree=tree, bench=build / "fraccontact-bench", fmu=build / "fraccontact.fmu",
-                   commit=git(root, "rev-parse", "--short", commit))
+                   solve=build / "fraccontact-solve", commit=git(root, "rev-parse", "--short", commit))
     finally:
         subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(tree)], capture_output=True)
         subprocess.run(["git", "-C", str(root), "worktree", "prune"], capture_output=True)
@@ -1188,6 +1189,86 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
     return out
 
 
+# --- instruction counts (issue 35) -------------------------------------------
+
+INSTRUCTIONS_BEGIN, INSTRUCTIONS_END = "<!-- instruction counts: begin -->", "<!-- instruction counts: end -->"
+# Issue 35's table: the dashpot's paths before the four issues that slowed
+# them (b022927) and where the issue found them (26f430c), each built anew.
+INSTRUCTIONS_BEFORE, INSTRUCTIONS_FOUND = "b022927", "26f430c"
+INSTRUCTIONS_ISSUE_ROWS = (("law 1, fixed steps, per step", "law1_fixed"),
+                           ("law 2, fixed steps, per step", "law2_fixed"),
+                           ("law 2, `--tolerance 1e-7 --dt-max 1e-3`, per impact", "dashpot_controlled_1e-7"))
+
+
+def instruction_counter(root):
+    """tests/instruction_counts.py, the guard's own counting, as a module."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("instruction_counts", root / "tests" / "instruction_counts.py")
+    counter = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(counter)
+    return counter
+
+
+def instruction_rows(root, program, fmu_file):
+    """Every row of the record counted on this build, and the issue's rows
+    on the two commits it compares."""
+    counter = instruction_counter(root)
+    toolchain, record = counter.read_record()
+    build = pathlib.Path(program).parent
+    paths = {"fraccontact-solve": program, "fraccontact-bench": build / "fraccontact-bench",
+             "fmu_importer": build / "fmu_importer",
+             "FMU_BINARY": pathlib.Path(str(fmu_file) + ".d") / "binaries" / "linux64" / "fraccontact.so"}
+    here = [dict(row, value=counter.measure(row, paths)) for row in record]
+    by_name = {row["name"]: row for row in record}
+    then = {}
+    for commit in (INSTRUCTIONS_BEFORE, INSTRUCTIONS_FOUND):
+        say(f"  building {commit} in a temporary git worktree ...")
+        with base_build(root, commit, ("fraccontact-solve",)) as base:
+            then[commit] = {name: counter.measure(by_name[name], {"fraccontact-solve": base["solve"]})
+                            for _, name in INSTRUCTIONS_ISSUE_ROWS}
+    compiler = [line.split("=", 1)[1] for line in (build / "CMakeCache.txt").read_text().splitlines()
+                if line.startswith("CMAKE_C_COMPILER:")][0]
+    return dict(here=here, then=then, toolchain=counter.toolchain_of(compiler), recorded=toolchain,
+                head=git(root, "rev-parse", "--short", "HEAD"))
+
+
+def instruction_count(value):
+    return f"{value / 1e3:.1f} k" if value >= 1e4 else f"{value:.0f}"
+
+
+def instructions_section(r):
+    before, found = (r["then"][c] for c in (INSTRUCTIONS_BEFORE, INSTRUCTIONS_FOUND))
+    here = {row["name"]: row for row in r["here"]}
+    out = [INSTRUCTIONS_BEGIN, "## Instruction counts (issue 35)", "",
+           "Regenerate this section alone, in place: `scripts/report benchmarks --only instructions` (under a "
+           f"minute: it builds {INSTRUCTIONS_BEFORE} and {INSTRUCTIONS_FOUND} in temporary git worktrees). "
+           "Instructions counted by valgrind's callgrind as the difference of two repeat counts, so that start-up "
+           "and output cancel: exact, whatever the machine's load (the commands: `tests/instruction_counts.tsv`). "
+           f"Measured on commit {r['head']}, built by {r['toolchain']}"
+           + ("." if r["toolchain"] == r["recorded"] else f" (the record's: {r['recorded']}).") + "",
+           f"| run | {INSTRUCTIONS_BEFORE} | {INSTRUCTIONS_FOUND} | this commit | this / {INSTRUCTIONS_BEFORE} |",
+           "|---|---|---|---|---|"]
+    for label, name in INSTRUCTIONS_ISSUE_ROWS:
+        v = here[name]["value"]
+        out.append(f"| {label} | {instruction_count(before[name])} | {instruction_count(found[name])} | "
+                   f"{instruction_count(v)} | {v / before[name]:.3f} |")
+    worst = max(here[name]["value"] / before[name] for _, name in INSTRUCTIONS_ISSUE_ROWS)
+    out += ["", f"Every row at or below {INSTRUCTIONS_BEFORE}'s: **{'yes' if worst <= 1.0 else 'no'}** "
+            f"(at most {worst:.3f} of it).", "",
+            "The guard: `ctest -R instruction_counts` (in the normal build, where valgrind is installed; not in the "
+            "sanitizer build) counts these rows and fails one more than 2 % above its record in "
+            "`tests/instruction_counts.tsv`, or more than 10 % below it (a record that low would let a regression "
+            "of that size pass). The record holds for the toolchain it names; another one skips the test. After a "
+            "change that moves a count on purpose, `cmake --build build --target update-instruction-counts` "
+            "rewrites the record, in a commit that says why.", "",
+            "| row | command | per | record | this build | this / record |", "|---|---|---|---|---|---|"]
+    for row in r["here"]:
+        out.append(f"| {row['name']} | `{row['command']}` | {row['unit']} | {row['record']:,.1f} | "
+                   f"{row['value']:,.1f} | {row['value'] / row['record']:.4f} |")
+    out += ["", INSTRUCTIONS_END]
+    return out
+
+
 def write(path, steps, precision, g1, alpha, package, springpot, controlled):
     h = steps["ns_per_step"]
     lit = steps["ns_literal_sum"]
@@ -1237,6 +1318,7 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
             "point counts as off). `GLpoint` scales by (N+1)/(b-a) where the grid's step is (b-a)/N, an O(1/N) "
             "error. Ours is compiled and O(N) at the newest point; over the full grid it pays for the padding and "
             "the direct head but is right at every point.", ""] + package + [""] + springpot + [""] + controlled
+    out += [""] + kept_section(path, INSTRUCTIONS_BEGIN, INSTRUCTIONS_END, [])
     atomic.write_text(path, "\n".join(out) + "\n")
 
 
@@ -1244,11 +1326,12 @@ def main(argv=None, prog=None):
     parser = reports.parser(prog, __doc__)
     reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
     reports.add_fmu(parser)
-    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled"],
+    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions"],
                         help="regenerate one section alone, in place (precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
                              "core; springpot: the springpot's memories, and the dashpot against the commit before "
-                             "them; controlled: the springpot against the dashpot under error control)")
+                             "them; controlled: the springpot against the dashpot under error control; "
+                             "instructions: the instruction counts of the guard's runs, and issue 35's table)")
     parser.add_argument("--largest-n", type=float, default=1e6,
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = reports.parse(parser, argv)
@@ -1274,6 +1357,12 @@ def main(argv=None, prog=None):
         say("the springpot under error control ...")
         replace_section(args.out / "benchmarks.md", controlled_section(*controlled_rows(bench)), CONTROLLED_BEGIN,
                         CONTROLLED_END)
+        print((args.out / "benchmarks.md").read_text())
+        return
+    if args.only == "instructions":
+        say("instruction counts ...")
+        section = instructions_section(instruction_rows(reports.source_tree(), program, args.fmu))
+        replace_section(args.out / "benchmarks.md", section, INSTRUCTIONS_BEGIN, INSTRUCTIONS_END)
         print((args.out / "benchmarks.md").read_text())
         return
     root = reports.source_tree()

@@ -146,7 +146,7 @@ MUTANTS = [
     mutant("step-count", "time scheme", "H = n dt_max takes n + 1 internal steps (ceil forgives no ulp)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
            "N = 10 steps per 1 us",
-           (EVOLVE, "(1.0 - 1e-12)));", "(1.0 + 1e-12)));")),
+           (EVOLVE, "(1.0 - 1e-12)),", "(1.0 + 1e-12)),")),
     mutant("radau-eigenvalue", "time scheme", "Radau IIA: A's real eigenvalue ×(1 + 1e-11) in the modes' elimination",
            "each mode's 1/(1 + h b λ) off by up to 1e-11; test_contact test_radau_modes_are_the_last_stage: "
            "the advanced modes against the last stage solved from A built anew, 1e-13 of their scale",
