@@ -410,9 +410,9 @@ static void gauss(int n, double M[5][5], double x[5])
     }
 }
 
-/* The default springpot on the Hertz spring at this tolerance, 3e-4 s
- * into the h20 impact: in contact, its memory's modes stirred. */
-static void start_springpot_in_contact(contact_model *cm, double tolerance)
+/* The default springpot on the Hertz spring at this tolerance, started on
+ * the h20 drop test. */
+static void start_springpot(contact_model *cm, double tolerance)
 {
     contact_params p;
     double v0, m;
@@ -422,6 +422,13 @@ static void start_springpot_in_contact(contact_model *cm, double tolerance)
     p.damper = CONTACT_DAMPER_SPRINGPOT;
     p.tolerance = tolerance;
     contact_start(cm, &p, v0, m);
+}
+
+/* The same 3e-4 s into the h20 impact: in contact, its memory's modes
+ * stirred. */
+static void start_springpot_in_contact(contact_model *cm, double tolerance)
+{
+    start_springpot(cm, tolerance);
     contact_advance(cm, 3e-4);
 }
 
@@ -545,17 +552,10 @@ static void test_a_start_on_any_memory_runs_as_on_zeros(void)
     double tolerances[] = {0.0, 1e-8};
     int i;
     for (i = 0; i < 2; i++) {
-        contact_params p;
-        double v0, m;
-        contact_default_params(&p);
-        contact_default_striker(&v0, &m);
-        p.law = CONTACT_LAW_HERTZ;
-        p.damper = CONTACT_DAMPER_SPRINGPOT;
-        p.tolerance = tolerances[i];
         memset(&dirty, 0xff, sizeof dirty);
         memset(&clean, 0, sizeof clean);
-        contact_start(&dirty, &p, v0, m);
-        contact_start(&clean, &p, v0, m);
+        start_springpot(&dirty, tolerances[i]);
+        start_springpot(&clean, tolerances[i]);
         while (clean.s.impacts == 0 && clean.s.t < 3e-3) {
             contact_advance(&clean, 1e-5);
             contact_advance(&dirty, 1e-5);
