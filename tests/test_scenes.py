@@ -20,7 +20,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from fraccontact import fmu_path
+from fraccontact import fmu_path, omsimulator
 from fraccontact.fmu import Slave, unpacked
 from fraccontact.scenes import masters, systems
 
@@ -309,7 +309,9 @@ def test_a_fine_step_gives_its_figures_in_bounded_time(references):
     assert json.loads(r.stdout)["HIC15"] == pytest.approx(want, rel=1e-4, abs=0)
 
 
-@pytest.mark.parametrize("master", masters.MASTERS)
+@pytest.mark.parametrize("master", [pytest.param(m, marks=pytest.mark.skipif(
+    m == "omsimulator" and not omsimulator.available(), reason="OMSimulator is not installed (docs/ssp.md)"))
+    for m in masters.MASTERS])
 def test_ctrl_c_stops_a_scene_on_one_line(master):
     """Item 13: SIGINT mid-run (a run of 1 s of simulated time, far longer
     than the wait): one line, exit status 130, nothing on stdout. (SIGINT's
