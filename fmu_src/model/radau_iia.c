@@ -73,13 +73,21 @@ static const double radau_e_t[STAGES] = {-2.9488838958995656, -2.112506220735840
     static void name##_sse2 params { name args; }                               \
     __attribute__((target("avx"))) static void name##_avx params { name args; } \
     __attribute__((target("avx512f"))) static void name##_avx512 params { name args; }
+/* the same with the lanes one vector holds as the first argument */
+#define CPU_WIDTH_VERSIONS(name, params, ...)                                                 \
+    static void name##_sse2 params { name(2, __VA_ARGS__); }                                  \
+    __attribute__((target("avx"))) static void name##_avx params { name(4, __VA_ARGS__); } \
+    __attribute__((target("avx512f"))) static void name##_avx512 params { name(8, __VA_ARGS__); }
 #define CPU_VERSION(name, args)                                                                         \
     (__builtin_cpu_supports("avx512f") ? name##_avx512 args : __builtin_cpu_supports("avx") ? name##_avx args \
                                                                                           : name##_sse2 args)
+#define CPU_WIDTH_VERSION(name, width, ...) CPU_VERSION(name, (__VA_ARGS__))
 #else
 #define ALWAYS_INLINE
 #define CPU_VERSIONS(name, params, args)
+#define CPU_WIDTH_VERSIONS(name, params, ...)
 #define CPU_VERSION(name, args) name args
+#define CPU_WIDTH_VERSION(name, width, ...) name(width, __VA_ARGS__)
 #endif
 
 typedef struct {
@@ -164,12 +172,15 @@ typedef struct {
  * lanes in their order, and the lanes are added in a fixed order after, so
  * that a CPU's vector width changes no bit of them (C99 contracts no
  * multiply-add). The modes are padded to whole lanes with a = b = phi = 0,
- * which add exact zeros. The lanes are local, so that they stay in the
- * vector registers. */
+ * which add exact zeros. The lanes that one vector holds (width of them,
+ * from first) are summed in two passes over their modes, the sums of a d
+ * and then those of a phi d, so that each pass's sums stay in the vector
+ * registers. */
 enum { SUM_P0, SUM_Q0, SUM_PP0, SUM_QQ0, SUM_RELAXED, SUM_P1R, SUM_P1I, SUM_Q1R, SUM_Q1I, SUM_P2R, SUM_P2I,
        SUM_Q2R, SUM_Q2I, SUMS };
 
-static inline ALWAYS_INLINE void memory_sums_in_lanes(contact_modes *m, double h, double sum[SUMS])
+static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int first, contact_modes *m, double h,
+                                                        double sum[SUMS][CONTACT_MODE_LANES])
 {
     const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
@@ -177,49 +188,71 @@ static inline ALWAYS_INLINE void memory_sums_in_lanes(contact_modes *m, double h
     size_t j;
     int k, n;
     for (n = 0; n < SUMS; n++)
-        for (k = 0; k < CONTACT_MODE_LANES; k++)
+        for (k = 0; k < width; k++)
             lane[n][k] = 0.0;
-    for (j = 0; j < m->modes; j += CONTACT_MODE_LANES) {
+    for (j = first; j < m->modes; j += CONTACT_MODE_LANES) { /* the reciprocals and the sums of a d */
 #pragma omp simd
-        for (k = 0; k < CONTACT_MODE_LANES; k++) {
-            const double x = h * m->b[j + k], a = m->a[j + k], ap = a * m->phi[j + k];
+        for (k = 0; k < width; k++) {
+            const double x = h * m->b[j + k], a = m->a[j + k];
             const double D0 = 1.0 + x * l0;
             const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
             const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
             const double inv = 1.0 / (D0 * (N1 * N2));
             const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
-            const double apd = ap * d0, ad = a * d0, ak1 = a * k1, apk1 = ap * k1, ak2 = a * k2, apk2 = ap * k2;
+            const double ad = a * d0, ak1 = a * k1, ak2 = a * k2;
             m->radau_d[0][j + k] = d0;
             m->radau_d[1][j + k] = k1;
             m->radau_d[2][j + k] = k2;
-            lane[SUM_RELAXED][k] += apd * (x * l0);
-            lane[SUM_P0][k] += apd;
             lane[SUM_Q0][k] += ad;
-            lane[SUM_PP0][k] += apd * d0;
             lane[SUM_QQ0][k] += ad * d0;
-            lane[SUM_P1R][k] += apk1 * u1;
-            lane[SUM_P1I][k] -= apk1 * v1;
             lane[SUM_Q1R][k] += ak1 * u1;
             lane[SUM_Q1I][k] -= ak1 * v1;
-            lane[SUM_P2R][k] += apk2 * u2;
-            lane[SUM_P2I][k] -= apk2 * v2;
             lane[SUM_Q2R][k] += ak2 * u2;
             lane[SUM_Q2I][k] -= ak2 * v2;
         }
     }
+    for (j = first; j < m->modes; j += CONTACT_MODE_LANES) { /* the sums of a phi d, from the reciprocals */
+#pragma omp simd
+        for (k = 0; k < width; k++) {
+            const double x = h * m->b[j + k], ap = m->a[j + k] * m->phi[j + k];
+            const double u1 = 1.0 + x * r1, v1 = x * i1;
+            const double u2 = 1.0 + x * r2, v2 = x * i2;
+            const double d0 = m->radau_d[0][j + k];
+            const double apd = ap * d0, apk1 = ap * m->radau_d[1][j + k], apk2 = ap * m->radau_d[2][j + k];
+            lane[SUM_RELAXED][k] += apd * (x * l0);
+            lane[SUM_P0][k] += apd;
+            lane[SUM_PP0][k] += apd * d0;
+            lane[SUM_P1R][k] += apk1 * u1;
+            lane[SUM_P1I][k] -= apk1 * v1;
+            lane[SUM_P2R][k] += apk2 * u2;
+            lane[SUM_P2I][k] -= apk2 * v2;
+        }
+    }
+    for (n = 0; n < SUMS; n++)
+        for (k = 0; k < width; k++)
+            sum[n][first + k] = lane[n][k];
+}
+
+static inline ALWAYS_INLINE void memory_sums_in_lanes(const int width, contact_modes *m, double h,
+                                                      double sum[SUMS])
+{
+    double lanes[SUMS][CONTACT_MODE_LANES];
+    int first, k, n;
+    for (first = 0; first < CONTACT_MODE_LANES; first += width)
+        memory_sums_in_vector(width, first, m, h, lanes);
     for (n = 0; n < SUMS; n++) {
-        sum[n] = lane[n][0];
+        sum[n] = lanes[n][0];
         for (k = 1; k < CONTACT_MODE_LANES; k++)
-            sum[n] += lane[n][k];
+            sum[n] += lanes[n][k];
     }
 }
 
-CPU_VERSIONS(memory_sums_in_lanes, (contact_modes *m, double h, double sum[SUMS]), (m, h, sum))
+CPU_WIDTH_VERSIONS(memory_sums_in_lanes, (contact_modes *m, double h, double sum[SUMS]), m, h, sum)
 
 static void memory_sums_of(contact_modes *m, double h, memory_sums *s)
 {
     double sum[SUMS];
-    CPU_VERSION(memory_sums_in_lanes, (m, h, sum));
+    CPU_WIDTH_VERSION(memory_sums_in_lanes, 2, m, h, sum);
     m->radau_h = h;
     s->p[0].re = sum[SUM_P0], s->p[0].im = 0.0, s->q[0].re = sum[SUM_Q0], s->q[0].im = 0.0;
     s->p[1].re = sum[SUM_P1R], s->p[1].im = sum[SUM_P1I], s->q[1].re = sum[SUM_Q1R], s->q[1].im = sum[SUM_Q1I];
