@@ -1245,7 +1245,7 @@ def instructions_section(r):
            "Instructions counted by valgrind's callgrind as the difference of two repeat counts, so that start-up "
            "and output cancel: exact, whatever the machine's load (the commands: `tests/instruction_counts.tsv`). "
            f"Measured on commit {r['head']}, built by {r['toolchain']}"
-           + ("." if r["toolchain"] == r["recorded"] else f" (the record's: {r['recorded']}).") + "",
+           + ("." if r["toolchain"] == r["recorded"] else f" (the record's: {r['recorded']})."), "",
            f"| run | {INSTRUCTIONS_BEFORE} | {INSTRUCTIONS_FOUND} | this commit | this / {INSTRUCTIONS_BEFORE} |",
            "|---|---|---|---|---|"]
     for label, name in INSTRUCTIONS_ISSUE_ROWS:
