@@ -19,8 +19,6 @@
  * the centre of mass moves at the constant acceleration f/(m + m_a). */
 #include <math.h>
 #include <stddef.h>
-#include <stdlib.h>
-#include <string.h>
 
 #include "fmu_interface.h"
 #include "fmu_vars.h"
@@ -83,27 +81,9 @@ static void start_state(fmu_model *fm)
     fm->E_diss = 0.0;
 }
 
-fmu_model *fm_new(fm_report report, void *env)
+/* The start values that are not 0, and the outputs they give. */
+static void start_values(fmu_model *fm)
 {
-    fmu_model *fm = calloc(1, sizeof *fm);
-    if (!fm)
-        return NULL;
-    fm->log.report = report;
-    fm->log.env = env;
-    fm_reset(fm);
-    return fm;
-}
-
-void fm_free(fmu_model *fm)
-{
-    free(fm);
-}
-
-void fm_reset(fmu_model *fm)
-{
-    fmu_reporter log = fm->log;
-    memset(fm, 0, sizeof *fm);
-    fm->log = log;
     fm->m = 1.0;
     update_outputs(fm);
 }
@@ -138,46 +118,6 @@ fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
         start_state(fm);
     update_outputs(fm);
     return FM_OK;
-}
-
-fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
-{
-    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
-    if (!var)
-        return FM_ERROR;
-    *value = *(const double *)((const char *)fm + var->offset);
-    return FM_OK;
-}
-
-/* The body has no Integer and no Boolean variable: every reference to one
- * is reported as unknown. */
-static fm_status none_of(fmu_model *fm, unsigned vr, var_type type)
-{
-    return fmu_find(&variables, vr, type, &fm->log) ? FM_OK : FM_ERROR;
-}
-
-fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
-{
-    (void)value;
-    return none_of(fm, vr, VAR_INTEGER);
-}
-
-fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
-{
-    (void)value;
-    return none_of(fm, vr, VAR_INTEGER);
-}
-
-fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
-{
-    (void)value;
-    return none_of(fm, vr, VAR_BOOLEAN);
-}
-
-fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
-{
-    (void)value;
-    return none_of(fm, vr, VAR_BOOLEAN);
 }
 
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
@@ -330,3 +270,5 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     update_outputs(fm);
     return FM_OK;
 }
+
+#include "fmu_defaults.h" /* the hooks not written above */

@@ -8,7 +8,6 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 /* The model advanced by one more communication step from the end of the
@@ -31,19 +30,28 @@ typedef struct {
     double v, m, v2, m2, a, a2;
 } bodies;
 
+/* The communication step's side of the coupling: the force outputs, the
+ * impulse owed and the energy account, which a refused step puts back as
+ * they were. */
+typedef struct {
+    double F_avg;         /* impulse of the last communication step / its length */
+    double span;          /* that length: where an early return cut it, so far */
+    double F_avg_next;    /* (predicted impulse of the next step + owed) / H; F before the first step */
+    double owed;          /* the contact's impulse so far less what F_avg_next announced over it [N s] */
+    double announced;     /* F_avg_next as the communication step began: what the master applies over it */
+    double start;         /* where the communication step began, */
+    double H;             /* the step size requested then (FM_CONTINUE goes on with both), and
+                             the length of the step F_avg_next predicts */
+    coupling_energy energy; /* a proxy striker's energy account (docs/model.md §17) */
+    double correction;    /* what the account adds to the force output for the bodies' next interval */
+} step_account;
+
 struct fmu_model {
     contact_params params;
     int coupling;         /* enum fmu_coupling */
     bodies in;            /* the inputs as last set */
     double v_slope;       /* dv/dt given by the master for the next step (0: v held) */
-    double F_avg;         /* impulse of the last communication step / its length */
-    double step_span;     /* that length: where an early return cut it, so far */
-    double F_avg_next;    /* (predicted impulse of the next step + owed) / step_H; F before the first step */
-    double owed;          /* the contact's impulse so far less what F_avg_next announced over it [N s] */
-    double announced;     /* F_avg_next as the communication step began: what the master applies over it */
-    double step_start;    /* where the communication step began, */
-    double step_H;        /* the step size requested then (FM_CONTINUE goes on with both), and
-                             the length of the step F_avg_next predicts */
+    step_account step;
     int64_t predicted;    /* communication steps taken from the prediction, */
     int64_t computed;     /* and computed afresh */
     int started;          /* past initialization: fixed parameters are frozen */
@@ -51,8 +59,6 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
-    coupling_energy energy; /* a proxy striker's energy account (docs/model.md §17) */
-    double correction;    /* what the account adds to the force output for the bodies' next interval */
     contact_model model;
     prediction next;
     fmu_reporter log;
@@ -193,34 +199,14 @@ static void preview_start(fmu_model *fm)
     }
 }
 
-fmu_model *fm_new(fm_report report, void *env)
-{
-    fmu_model *fm = calloc(1, sizeof *fm);
-    if (!fm)
-        return NULL;
-    fm->log.report = report;
-    fm->log.env = env;
-    fm_reset(fm);
-    return fm;
-}
-
-void fm_free(fmu_model *fm)
-{
-    contact_release(&fm->model);
-    free(fm);
-}
-
 double fm_time(const fmu_model *fm)
 {
     return fm->model.s.t;
 }
 
-void fm_reset(fmu_model *fm)
+/* The start values that are not 0, and the outputs they give. */
+static void start_values(fmu_model *fm)
 {
-    fmu_reporter log = fm->log;
-    contact_release(&fm->model);
-    memset(fm, 0, sizeof *fm);
-    fm->log = log;
     contact_default_params(&fm->params);
     contact_default_striker(&fm->in.v, &fm->in.m);
     fm->coupling = COUPLING_GAUSS_SEIDEL;
@@ -256,9 +242,10 @@ static double real_output(const fmu_model *fm, unsigned vr)
     const contact_model *cm = &fm->model;
     switch (vr) {
     case VR_F: return cm->s.F;
-    case VR_F_avg: return fm->F_avg + (fm->coupling == COUPLING_GAUSS_SEIDEL ? fm->correction : 0.0);
-    case VR_F_avg_next: return fm->started ? fm->F_avg_next + (fm->coupling == COUPLING_JACOBI ? fm->correction : 0.0)
-                                           : cm->s.F;
+    case VR_F_avg: return fm->step.F_avg + (fm->coupling == COUPLING_GAUSS_SEIDEL ? fm->step.correction : 0.0);
+    case VR_F_avg_next:
+        return fm->started ? fm->step.F_avg_next + (fm->coupling == COUPLING_JACOBI ? fm->step.correction : 0.0)
+                           : cm->s.F;
     case VR_F_peak: return cm->s.F_peak;
     case VR_x: return contact_total_indentation(cm);
     case VR_x1: return contact_elastic_indentation(cm);
@@ -297,21 +284,6 @@ fm_status fm_set_integer(fmu_model *fm, unsigned vr, int value)
 {
     const fmu_variable *var = fmu_settable(&variables, vr, VAR_INTEGER, fm->started, &fm->log);
     return var ? set_parameter(fm, var, &value, sizeof value) : FM_ERROR;
-}
-
-fm_status fm_get_integer(fmu_model *fm, unsigned vr, int *value)
-{
-    const fmu_variable *var = fmu_find(&variables, vr, VAR_INTEGER, &fm->log);
-    if (!var)
-        return FM_ERROR;
-    *value = *(const int *)((const char *)fm + var->offset);
-    return FM_OK;
-}
-
-fm_status fm_set_boolean(fmu_model *fm, unsigned vr, int value)
-{
-    (void)value;
-    return fmu_settable(&variables, vr, VAR_BOOLEAN, fm->started, &fm->log) ? FM_OK : FM_ERROR;
 }
 
 fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
@@ -388,14 +360,10 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     contact_start(&fm->model, &fm->params, approach(&fm->in), proxy_mass(&fm->in));
     fm->model.max_steps = MAX_STEPS;
     fm->model.s.t = t0;
-    fm->F_avg = 0.0;
-    fm->step_span = 0.0;
+    memset(&fm->step, 0, sizeof fm->step);
     /* No step length yet to predict over: the force now, the limit of a
      * vanishing step (0 at the start, where the striker has not touched). */
-    fm->F_avg_next = fm->model.s.F;
-    fm->owed = fm->announced = fm->step_start = fm->step_H = 0.0;
-    memset(&fm->energy, 0, sizeof fm->energy);
-    fm->correction = 0.0;
+    fm->step.F_avg_next = fm->model.s.F;
     fm->predicted = fm->computed = 0;
     fm->next.valid = 0;
     fm->held = 0;
@@ -503,7 +471,7 @@ static double start_velocity(const fmu_model *fm, double v_end, int *other)
     if (fm->params.scene != CONTACT_SCENE_DRIVEN || !(fm->in.m > 0.0))
         return approach(&fm->in);
     /* the impulse owed acts on both bodies: on their approach through the reduced mass */
-    jacobi = approach(&fm->in) - fm->owed / proxy_mass(&fm->in);
+    jacobi = approach(&fm->in) - fm->step.owed / proxy_mass(&fm->in);
     gauss_seidel = approach(&fm->in);
     v = fm->coupling == COUPLING_JACOBI ? jacobi : gauss_seidel;
     if (same_motion(fm, v, v_end))
@@ -566,28 +534,28 @@ static double bodies_accel(const fmu_model *fm)
  * under Gauss-Seidel, the next under Jacobi). */
 static void account_step(fmu_model *fm, double H, const contact_state *start, double J, double owed)
 {
-    coupling_energy *e = &fm->energy, next;
+    coupling_energy *e = &fm->step.energy, next;
     const contact_model *cm = &fm->model;
     const prediction *p = &fm->next;
     const double m = proxy_mass(&fm->in);
     if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
-        coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->F_avg);
+        coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->step.F_avg);
         coupling_energy_proxy(e, cm, start, &cm->s, J, 0.0, 0.0);
-        fm->correction = coupling_energy_correction(e, m);
-        e->F += fm->correction;
+        fm->step.correction = coupling_energy_correction(e, m);
+        e->F += fm->step.correction;
         return;
     }
-    coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->announced + fm->correction);
-    coupling_energy_proxy(e, cm, start, &cm->s, J, owed / m, fm->owed / m);
+    coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->step.announced + fm->step.correction);
+    coupling_energy_proxy(e, cm, start, &cm->s, J, owed / m, fm->step.owed / m);
     /* the next interval: the bodies' start predicted from this one's, the
      * proxy's motion from its own end (owing nothing then), moved to it */
     next = coupling_energy_predicted(e, m);
-    coupling_energy_open(&next, fm->step_H, next.u, next.a, fm->F_avg_next);
-    coupling_energy_proxy(&next, cm, &cm->s, p->valid ? &p->model.s : &cm->s, fm->F_avg_next * fm->step_H - fm->owed,
-                          fm->owed / m, 0.0);
+    coupling_energy_open(&next, fm->step.H, next.u, next.a, fm->step.F_avg_next);
+    coupling_energy_proxy(&next, cm, &cm->s, p->valid ? &p->model.s : &cm->s,
+                          fm->step.F_avg_next * fm->step.H - fm->step.owed, fm->step.owed / m, 0.0);
     next.u1 += next.u - next.u0;
     next.u0 = next.u;
-    fm->correction = coupling_energy_correction(&next, m);
+    fm->step.correction = coupling_energy_correction(&next, m);
 }
 
 /* The model driven by the inputs for a step of length H > 0 from the
@@ -619,16 +587,12 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     memory_copy memory;
     double impulse, part, t_start, end, v_end;
     const fmu_variable *overflow;
-    /* the outputs and the coupling's account as they were, for a refusal */
-    const double F_avg = fm->F_avg, step_span = fm->step_span, F_avg_next = fm->F_avg_next, owed = fm->owed,
-                 announced = fm->announced, step_start = fm->step_start, step_H = fm->step_H;
+    const step_account saved = fm->step; /* as it was, for a refusal */
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
     /* a step of the energy account: the master's whole step (an early
      * return's part is one), not the rest of a step cut inside the FMU */
     const int accounted = !resume && proxy_striker(fm);
-    const coupling_energy energy = fm->energy;
-    const double correction = fm->correction;
     int from_prediction, other_coupling;
     *event = 0;
     if (H == 0.0) {
@@ -643,14 +607,15 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         return FM_ERROR;
     fm_update_discrete(fm);
     if (!resume) { /* a new communication step: what a Jacobi master applies over it, where and how long */
-        fm->announced = fm->F_avg_next;
-        fm->step_start = t;
-        fm->step_H = H;
+        fm->step.announced = fm->step.F_avg_next;
+        fm->step.start = t;
+        fm->step.H = H;
     }
     if (accounted) /* the inputs end the bodies' last interval */
-        coupling_energy_close(&fm->energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
+        coupling_energy_close(&fm->step.energy, proxy_mass(&fm->in), approach(&fm->in), bodies_accel(fm));
     if (accounted)
-        coupling_energy_restart(&fm->energy, fm->coupling == COUPLING_JACOBI ? fm->owed : 0.0, cm->s.v - v_end);
+        coupling_energy_restart(&fm->step.energy, fm->coupling == COUPLING_JACOBI ? fm->step.owed : 0.0,
+                                cm->s.v - v_end);
     before = cm->s;
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
@@ -661,10 +626,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         impulse = contact_advance_until(cm, H, stop_at);
     }
     if (isnan(impulse)) {
-        fm->energy = energy;
-        fm->announced = announced;
-        fm->step_start = step_start;
-        fm->step_H = step_H;
+        fm->step = saved;
         fm->next.valid = 0;
         if (cm->exceeded)
             return report(fm, FM_ERROR, "logStatusError",
@@ -682,7 +644,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
      * an event too), or carries the time to an event over to it, never
      * past that point. So the master's rounding of its time changes no
      * result, and the predicted step is the step. */
-    end = resume ? fm->step_start + fm->step_H : t + H; /* as the master adds them */
+    end = resume ? fm->step.start + fm->step.H : t + H; /* as the master adds them */
     if (!*event)
         cm->s.t = end;
     else
@@ -690,38 +652,31 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     part = *event ? cm->s.t - t : H;
     /* The impulse the contact exerted beyond what F_avg_next announced for
      * this part of the communication step: owed to the striker. */
-    fm->owed += impulse - fm->announced * part;
+    fm->step.owed += impulse - fm->step.announced * part;
     if (resume) { /* the average over the whole communication step so far */
-        impulse += fm->F_avg * fm->step_span;
-        part += fm->step_span;
+        impulse += fm->step.F_avg * fm->step.span;
+        part += fm->step.span;
     }
-    fm->F_avg = part > 0.0 ? impulse / part : cm->s.F;
-    fm->step_span = part;
+    fm->step.F_avg = part > 0.0 ? impulse / part : cm->s.F;
+    fm->step.span = part;
     /* The next communication step, as long as this one was requested, from
      * wherever this one ended; without a prediction the average force of
      * this step, held. */
-    predict(fm, fm->step_H);
-    fm->F_avg_next = (fm->next.valid ? fm->next.impulse / fm->step_H : fm->F_avg) + fm->owed / fm->step_H;
+    predict(fm, fm->step.H);
+    fm->step.F_avg_next =
+        (fm->next.valid ? fm->next.impulse / fm->step.H : fm->step.F_avg) + fm->step.owed / fm->step.H;
     if (accounted)
-        account_step(fm, part, &before, impulse, owed);
+        account_step(fm, part, &before, impulse, saved.owed);
     else { /* no proxy, or the rest of a step cut at an event inside the FMU: left out of the account */
-        fm->energy.open = 0;
-        fm->correction = 0.0;
+        fm->step.energy.open = 0;
+        fm->step.correction = 0.0;
     }
     overflow = nonfinite_output(fm);
     if (overflow) {
         double value = real_output(fm, overflow->vr);
         cm->s = before;
         restore_memory(cm, &memory);
-        fm->F_avg = F_avg;
-        fm->step_span = step_span;
-        fm->F_avg_next = F_avg_next;
-        fm->energy = energy;
-        fm->correction = correction;
-        fm->owed = owed;
-        fm->announced = announced;
-        fm->step_start = step_start;
-        fm->step_H = step_H;
+        fm->step = saved;
         fm->next.valid = 0; /* a memo: dropping it changes no result */
         *event = 0;
         return report(fm, FM_ERROR, "logStatusError",
@@ -764,17 +719,18 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
 #define STATE_F(field) F(model.s.field),
 #define STATE_L(field) L(model.s.field),
 #define STATE_I(field) I(model.s.field),
+#define ENERGY_F(field) F(step.energy.field)
 
 static const state_field state_fields[] = {
     F(params.R), F(params.E_i), F(params.nu_i), F(params.E_s), F(params.nu_s), F(params.k), F(params.c),
     F(params.dt_max), F(params.tolerance), F(params.g), F(params.gap0), I(params.law), I(params.g1_nodes), I(params.scene),
     I(params.scheme), F(params.spring_exponent), I(params.damper), F(in.v), F(in.m), F(in.v2), F(in.m2), F(in.a),
-    F(in.a2), F(v_slope), F(F_avg), F(step_span),
-    I(coupling), F(F_avg_next), F(owed), F(announced), F(step_start), F(step_H), L(predicted), L(computed),
-    I(started), I(held), I(held_contact), F(held_eps), F(energy.created), F(energy.rounding), F(energy.H),
-    F(energy.u), F(energy.a), F(energy.a_rate), F(energy.a_unseen), F(energy.F), F(energy.u0), F(energy.u1),
-    F(energy.F_end), F(energy.dx), F(energy.scale), F(energy.lag), I(energy.open), I(energy.ends_free),
-    F(correction),
+    F(in.a2), F(v_slope), F(step.F_avg), F(step.span),
+    I(coupling), F(step.F_avg_next), F(step.owed), F(step.announced), F(step.start), F(step.H), L(predicted),
+    L(computed), I(started), I(held), I(held_contact), F(held_eps), ENERGY_F(created), ENERGY_F(rounding),
+    ENERGY_F(H), ENERGY_F(u), ENERGY_F(a), ENERGY_F(a_rate), ENERGY_F(a_unseen), ENERGY_F(F), ENERGY_F(u0),
+    ENERGY_F(u1), ENERGY_F(F_end), ENERGY_F(dx), ENERGY_F(scale), ENERGY_F(lag), I(step.energy.open),
+    I(step.energy.ends_free), F(step.correction),
     F(model.inv_m), F(model.accel), CONTACT_STATE_FIELDS(STATE_F, STATE_L, STATE_I)};
 
 /* A springpot's parameters follow, then its memory: the count of values
@@ -852,7 +808,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
         || !(trial.model.s.F >= 0.0 && trial.model.s.F <= trial.model.s.F_peak)
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0
-        || trial.step_H < 0.0 || trial.step_span < 0.0 || trial.predicted < 0 || trial.computed < 0)
+        || trial.step.H < 0.0 || trial.step.span < 0.0 || trial.predicted < 0 || trial.computed < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
     for (i = 0; i < count; i++)
         if (!isfinite(serial_get_double(memory + 8 * i)))
@@ -875,3 +831,10 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     fm->next.valid = 0; /* a memo of the next step: the next step computes it again, to the bit */
     return FM_OK;
 }
+
+/* The hooks written above in place of the glue's defaults, which supply the rest. */
+#define FM_GET_REAL
+#define FM_SET_INTEGER
+#define FM_GET_BOOLEAN
+#define FM_RELEASE(fm) contact_release(&(fm)->model)
+#include "fmu_defaults.h"

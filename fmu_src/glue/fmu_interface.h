@@ -1,7 +1,8 @@
 /* What the FMI glue (fmi2_cosim.c, fmi3_cosim.c) asks of a model: the hook interface each
  * FMU's binding implements (fmu_src/binding/fmu_model.c for the contact
- * element, striker/striker_model.c for the striker). No FMI types: plain C
- * values and statuses numerically equal to the FMI ones. */
+ * element, striker/striker_model.c for the striker, bodies/body_model.c for
+ * the body), taking from fmu_defaults.h the hooks it does not write. No FMI
+ * types: plain C values and statuses numerically equal to the FMI ones. */
 #ifndef FRACCONTACT_FMU_INTERFACE_H
 #define FRACCONTACT_FMU_INTERFACE_H
 
