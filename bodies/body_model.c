@@ -104,57 +104,19 @@ static const char *rule_broken(unsigned vr, double value)
     return NULL;
 }
 
-fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
-{
-    const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
-    const char *why;
-    if (!var)
-        return FM_ERROR;
-    why = rule_broken(vr, value);
-    if (why)
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "%s = %g is invalid: %s", var->name, value, why);
-    *(double *)((char *)fm + var->offset) = value;
-    if (!fm->started) /* before initialization the outputs show the start */
-        start_state(fm);
-    update_outputs(fm);
-    return FM_OK;
-}
+#define FM_RATES "x, v and x_a"
 
-fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
+static int rate(const fmu_model *fm, unsigned vr, double *value)
 {
-    (void)value;
-    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
-                   "fmi2SetRealInputDerivatives: value reference %u, order %d: the body holds its inputs", vr,
-                   order);
-}
-
-fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value)
-{
-    if (order == 1 && vr == VR_x) {
+    if (vr == VR_x)
         *value = fm->v;
-        return FM_OK;
-    }
-    if (order == 1 && vr == VR_v) {
+    else if (vr == VR_v)
         *value = own_acceleration(fm) + (fm->F2 - fm->F) / fm->m;
-        return FM_OK;
-    }
-    if (order == 1 && vr == VR_x_a) {
+    else if (vr == VR_x_a)
         *value = fm->v_a;
-        return FM_OK;
-    }
-    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
-                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x, v and x_a, order 1", vr,
-                   order);
-}
-
-fm_status fm_start(fmu_model *fm, double t0, double t_stop)
-{
-    (void)t_stop;
-    fm->t = t0;
-    start_state(fm);
-    fm->started = 1;
-    update_outputs(fm);
-    return FM_OK;
+    else
+        return 0;
+    return 1;
 }
 
 /* e^(-beta t) C(t) and e^(-beta t) S(t) of the damped oscillator z'' + 2
@@ -232,43 +194,18 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     return FM_OK;
 }
 
-double fm_time(const fmu_model *fm)
-{
-    return fm->t;
-}
-
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
 static const state_field state_fields[] = {F(F),  F(F2), F(m),   F(k_s), F(c_s),    F(v0), F(m_a),
                                            F(x),  F(v),  F(x_a), F(v_a), F(E_diss), F(t),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
-#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
-
-size_t fm_state_size(const fmu_model *fm)
+/* Whether a state read is one the body can hold. */
+static int state_accepted(const fmu_model *trial)
 {
-    (void)fm;
-    return fmu_fields_size(state_fields, N_STATE_FIELDS);
+    return !rule_broken(VR_m, trial->m) && !rule_broken(VR_k_s, trial->k_s) && !rule_broken(VR_c_s, trial->c_s)
+           && !rule_broken(VR_m_a, trial->m_a);
 }
 
-void fm_state_write(const fmu_model *fm, unsigned char *bytes)
-{
-    fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
-}
-
-fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
-{
-    fmu_model trial = *fm;
-    if (size != fm_state_size(fm))
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
-    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
-    if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
-        || rule_broken(VR_k_s, trial.k_s) || rule_broken(VR_c_s, trial.c_s) || rule_broken(VR_m_a, trial.m_a)
-        || (trial.started != 0 && trial.started != 1))
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
-    *fm = trial;
-    update_outputs(fm);
-    return FM_OK;
-}
-
+#define FM_OUTPUTS(fm) update_outputs(fm)
 #include "fmu_defaults.h" /* the hooks not written above */

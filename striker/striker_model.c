@@ -53,21 +53,11 @@ static const char *rule_broken(unsigned vr, double value)
     return NULL;
 }
 
-fm_status fm_set_real(fmu_model *fm, unsigned vr, double value)
+/* The state at the start: at rest at x0 but for the speed v0. */
+static void start_state(fmu_model *fm)
 {
-    const fmu_variable *var = fmu_settable(&variables, vr, VAR_REAL, fm->started, &fm->log);
-    const char *why;
-    if (!var)
-        return FM_ERROR;
-    why = rule_broken(vr, value);
-    if (why)
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "%s = %g is invalid: %s", var->name, value, why);
-    *(double *)((char *)fm + var->offset) = value;
-    if (!fm->started) { /* before initialization the outputs show the start */
-        fm->x = fm->x0;
-        fm->v = fm->v0;
-    }
-    return FM_OK;
+    fm->x = fm->x0;
+    fm->v = fm->v0;
 }
 
 /* v' at the step's start: gravity, the held force and the spring. */
@@ -76,36 +66,17 @@ static double acceleration(const fmu_model *fm)
     return fm->g - fm->F / fm->m - fm->k_s / fm->m * (fm->x - fm->x0);
 }
 
-fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
-{
-    (void)value;
-    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
-                   "fmi2SetRealInputDerivatives: value reference %u, order %d: the striker holds its input", vr,
-                   order);
-}
+#define FM_RATES "x and v"
 
-fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double *value)
+static int rate(const fmu_model *fm, unsigned vr, double *value)
 {
-    if (order == 1 && vr == VR_x) {
+    if (vr == VR_x)
         *value = fm->v;
-        return FM_OK;
-    }
-    if (order == 1 && vr == VR_v) {
+    else if (vr == VR_v)
         *value = acceleration(fm);
-        return FM_OK;
-    }
-    return fmu_say(&fm->log, FM_ERROR, "logStatusError",
-                   "fmi2GetRealOutputDerivatives: value reference %u, order %d: only x and v, order 1", vr, order);
-}
-
-fm_status fm_start(fmu_model *fm, double t0, double t_stop)
-{
-    (void)t_stop;
-    fm->t = t0;
-    fm->x = fm->x0;
-    fm->v = fm->v0;
-    fm->started = 1;
-    return FM_OK;
+    else
+        return 0;
+    return 1;
 }
 
 /* With F held over a step: x'' = a - w^2 (x - x0), a = g - F/m,
@@ -127,41 +98,15 @@ fm_status fm_do_step(fmu_model *fm, double t, double H)
     return FM_OK;
 }
 
-double fm_time(const fmu_model *fm)
-{
-    return fm->t;
-}
-
 #define F(field) {offsetof(fmu_model, field), FIELD_F64}
 
 static const state_field state_fields[] = {F(F), F(m), F(g), F(x0), F(v0), F(k_s), F(t), F(x), F(v),
                                            {offsetof(fmu_model, started), FIELD_I32}};
 
-#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
-
-size_t fm_state_size(const fmu_model *fm)
+/* Whether a state read is one the striker can hold. */
+static int state_accepted(const fmu_model *trial)
 {
-    (void)fm;
-    return fmu_fields_size(state_fields, N_STATE_FIELDS);
-}
-
-void fm_state_write(const fmu_model *fm, unsigned char *bytes)
-{
-    fmu_fields_write(fm, state_fields, N_STATE_FIELDS, bytes);
-}
-
-fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
-{
-    fmu_model trial = *fm;
-    if (size != fm_state_size(fm))
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state has the wrong length");
-    fmu_fields_read(&trial, state_fields, N_STATE_FIELDS, bytes);
-    if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS) || rule_broken(VR_m, trial.m)
-        || rule_broken(VR_k_s, trial.k_s)
-        || (trial.started != 0 && trial.started != 1))
-        return fmu_say(&fm->log, FM_ERROR, "logStatusError", "the FMU state holds an invalid value");
-    *fm = trial;
-    return FM_OK;
+    return !rule_broken(VR_m, trial->m) && !rule_broken(VR_k_s, trial->k_s);
 }
 
 #include "fmu_defaults.h" /* the hooks not written above */

@@ -833,8 +833,14 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 }
 
 /* The hooks written above in place of the glue's defaults, which supply the rest. */
+#define FM_SET_REAL
 #define FM_GET_REAL
 #define FM_SET_INTEGER
 #define FM_GET_BOOLEAN
+#define FM_SET_INPUT_DERIVATIVE
+#define FM_GET_OUTPUT_DERIVATIVE
+#define FM_START
+#define FM_TIME
+#define FM_STATE
 #define FM_RELEASE(fm) contact_release(&(fm)->model)
 #include "fmu_defaults.h"
