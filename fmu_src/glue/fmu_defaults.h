@@ -1,26 +1,25 @@
-/* The hooks of fmu_interface.h that every binding would write alike, so that
- * a binding writes only what its model has (as Reference-FMUs' cosimulation.c
+/* The hooks of fmu_interface.h that bindings would write alike, so that a
+ * binding writes only what its model has (as Reference-FMUs' cosimulation.c
  * supplies a default for each function a model's config.h does not claim).
  *
- * A binding includes this file once, at its end, after its struct fmu_model
- * (with the members `log`, its fmu_reporter, `started`, set once
- * initialization ends, and `t`, its time), its table `variables` and the
- * functions the defaults it takes call: start_values; start_state for
- * FM_SET_REAL's and FM_START's, rule_broken for FM_SET_REAL's; rate and the
- * string FM_RATES for FM_GET_OUTPUT_DERIVATIVE's; state_accepted and the
- * table state_fields for FM_STATE's. Before including it, it defines the
- * macro of each hook it wrote itself (FM_SET_REAL, FM_GET_REAL,
- * FM_SET_INTEGER, FM_GET_INTEGER, FM_SET_BOOLEAN, FM_GET_BOOLEAN,
- * FM_SET_INPUT_DERIVATIVE, FM_GET_OUTPUT_DERIVATIVE, FM_START, FM_TIME, and
- * FM_STATE for the three of the FMU state), FM_RELEASE(fm) where its model
- * holds memory beyond the struct, and FM_OUTPUTS(fm) where it has outputs
- * derived from its state and inputs (set after a start, a value set and a
- * state read).
- * A default stores a value where the table says, with no rule of its own
- * but the Real values' rule_broken: a model with other rules for a type
- * writes its setter; for a type of which the model has no variable the
- * table reports every reference. The default input derivatives are refused
- * (the inputs are held over a step). */
+ * A binding includes this file once, at its end. Before it, it defines
+ * - struct fmu_model, with the members log (its fmu_reporter), started
+ *   (set when initialization ends) and t (its time), the table `variables`
+ *   and start_values;
+ * - the macro of each hook it wrote itself: FM_SET_REAL, FM_GET_REAL,
+ *   FM_SET_INTEGER, FM_GET_INTEGER, FM_SET_BOOLEAN, FM_GET_BOOLEAN,
+ *   FM_SET_INPUT_DERIVATIVE, FM_GET_OUTPUT_DERIVATIVE, FM_START, FM_TIME,
+ *   FM_STATE (the three of the FMU state);
+ * - what the defaults it takes call: start_state (FM_SET_REAL's, FM_START's),
+ *   rule_broken (FM_SET_REAL's), rate and the string FM_RATES
+ *   (FM_GET_OUTPUT_DERIVATIVE's), state_fields and state_accepted (FM_STATE's);
+ * - FM_RELEASE(fm) where its model holds memory beyond the struct, and
+ *   FM_OUTPUTS(fm) where it has outputs derived from its state and inputs
+ *   (derived again after a start, a value set and a state read).
+ * A default stores a value where the table says, with no rule but the Real
+ * values' rule_broken: a model with other rules for a type writes its
+ * setter; for a type of which the model has no variable, the table reports
+ * every reference. */
 #ifndef FRACCONTACT_FMU_DEFAULTS_H
 #define FRACCONTACT_FMU_DEFAULTS_H
 
@@ -149,6 +148,7 @@ fm_status fm_get_boolean(fmu_model *fm, unsigned vr, int *value)
 #endif
 
 #ifndef FM_SET_INPUT_DERIVATIVE
+/* The inputs are held over a step. */
 fm_status fm_set_input_derivative(fmu_model *fm, unsigned vr, int order, double value)
 {
     (void)value;
