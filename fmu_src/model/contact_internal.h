@@ -31,9 +31,10 @@ struct contact_method_record {
                                  ("central scheme's"), or NULL: its steps split at events */
     const char *fixed_steps;  /* why it takes fixed steps whatever the tolerance, or NULL */
     /* One trial step in contact of length h from *in with spring stiffness
-     * K into *out, returning the contact force's impulse (NULL on a
-     * uniform grid, whose grid_step takes its own steps). */
-    contact_trial_step step;
+     * K into *out, returning the contact force's impulse: the dashpot's and
+     * the springpot's (NULL: not that damper's method, or a uniform grid,
+     * whose grid_step takes its own steps). */
+    contact_trial_step dashpot_step, springpot_step;
     /* What accepting the trial step *trial makes of the method's memory
      * (NULL: nothing, the state is all it carries). */
     void (*accept)(contact_model *cm, const contact_state *trial);
@@ -68,6 +69,7 @@ int memory_at_rest(const contact_model *cm);
  * (sdirk_step below). */
 double sdirk_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+void advance_modes(contact_model *cm, double h, double z1, double z2);
 
 /* radau_iia.c, its record's step, memory and dense output (the tests take
  * them one by one). */
@@ -151,12 +153,18 @@ static inline double smaller(double a, double b) { return a < b ? a : b; }
 
 static inline int error_controlled(const contact_model *cm) { return cm->method->controls_error; }
 
+/* The method's trial step in contact, the damper's. */
+static inline contact_trial_step method_step(const contact_model *cm)
+{
+    return springpot(cm) ? cm->method->springpot_step : cm->method->dashpot_step;
+}
+
 /* A trial step from *in: the method's in contact; out of contact every
  * method takes SDIRK2's (a recovering springpot's steps, and the onset
  * search among them). */
 static inline double trial_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return in->in_contact ? cm->method->step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
+    return in->in_contact ? method_step(cm)(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
 }
 
 static inline double indentation_rate(const contact_model *cm, const contact_state *s)
@@ -193,12 +201,30 @@ static inline void carry_state(contact_state *to, const contact_state *from)
     memcpy(to, from, offsetof(contact_state, step));
 }
 
-/* Makes a trial step of the method m the model's state, and m's memory
- * follow. */
-static inline void accept_step(contact_model *cm, const contact_method_record *m, const contact_state *trial)
+/* What accepting an SDIRK2 step makes of the memory (its record's
+ * accept): the compressed memory's modes follow its stages. */
+static inline void sdirk2_accept(contact_model *cm, const contact_state *trial)
 {
-    if (m->accept)
-        m->accept(cm, trial);
+    if (compressed_memory(cm))
+        advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
+}
+
+/* Makes an SDIRK2 trial step the model's state, and its memory follow:
+ * inline, for the fixed steps split at events (SDIRK2's alone) and every
+ * method's steps out of contact; a call through the record there costs the
+ * fixed steps more than the noise (docs/benchmarks.md). */
+static inline void accept_sdirk2_step(contact_model *cm, const contact_state *trial)
+{
+    sdirk2_accept(cm, trial);
+    carry_state(&cm->s, trial);
+}
+
+/* Makes a trial step of the model's method the model's state, and its
+ * memory follow. */
+static inline void accept_step(contact_model *cm, const contact_state *trial)
+{
+    if (cm->method->accept)
+        cm->method->accept(cm, trial);
     carry_state(&cm->s, trial);
 }
 

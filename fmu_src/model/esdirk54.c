@@ -88,5 +88,5 @@ const contact_method_record esdirk54_method = {
     .method = CONTACT_METHOD_ESDIRK54,
     .name = "esdirk54",
     .controls_error = 1,
-    .step = esdirk_step,
+    .dashpot_step = esdirk_step,
 };

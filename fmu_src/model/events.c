@@ -49,7 +49,7 @@ void fly(contact_model *cm, double tau, int touches)
 {
     contact_state trial;
     sdirk_step(cm, &cm->s, tau, 0.0, &trial);
-    accept_step(cm, &sdirk2_method, &trial);
+    accept_sdirk2_step(cm, &trial);
     if (touches)
         touch(cm);
 }
@@ -233,7 +233,7 @@ double separation_within(contact_model *cm, const contact_state *s, double h, do
     int i;
     for (i = 0; i < 8; i++) {
         double rate, next;
-        *J = cm->method->step(cm, s, tau, K, trial);
+        *J = method_step(cm)(cm, s, tau, K, trial);
         rate = indentation_rate(cm, trial);
         if (trial->error > 1.0)
             return tau;
@@ -304,7 +304,7 @@ double recover(contact_model *cm, double h, int *touches)
     else if (*touches) /* it starts on the surface: contact at once */
         h = 0.0;
     if (h > 0.0)
-        accept_step(cm, &sdirk2_method, &trial);
+        accept_sdirk2_step(cm, &trial);
     if (*touches)
         touch(cm);
     return h;

@@ -13,12 +13,14 @@
  * a diverging state could reach it. */
 #define MAX_EVENTS_PER_STEP 1000
 
-/* One fixed step of length h, split at contact onset and separation.
- * Returns 0, 1 when it stopped early at an event of the mask stop_at (the
- * state's time tells where), or -1 when the events do not end (a diverging
- * state). Inline, as the controlled step below: contact_advance_until's
- * loop takes one at every internal step, and a call costs speed there. */
-static inline int fixed_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
+/* One SDIRK2 step of length h, split at contact onset and separation (the
+ * fixed steps split at events are SDIRK2's alone, so its step and accept
+ * are taken inline here, not through its record). Returns 0, 1 when it
+ * stopped early at an event of the mask stop_at (the state's time tells
+ * where), or -1 when the events do not end (a diverging state). Inline, as
+ * the controlled step below: contact_advance_until's loop takes one at
+ * every internal step, and a call costs speed there. */
+static inline int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s, trial;
     int events;
@@ -41,14 +43,14 @@ static inline int fixed_internal_step(contact_model *cm, double h, double *impul
             continue;
         }
         K = spring_stiffness(cm, s->n + 1);
-        J = cm->method->step(cm, s, h, K, &trial);
+        J = sdirk_step(cm, s, h, K, &trial);
         /* Separation is x1 falling to 0 on the way out: an indentation too
          * small for a double (x1 = v h underflows at v ~ 1e-317) is not one. */
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
             tau = locate_separation(cm, s, h, K, &trial, &J);
         peak = peak_force_within(cm, s, tau, K, &trial);
-        accept_step(cm, cm->method, &trial);
+        accept_sdirk2_step(cm, &trial);
         count_contact_step(s, peak);
         *impulse += J;
         if (!separates)
@@ -81,7 +83,7 @@ static inline int controlled_internal_step(contact_model *cm, double remaining, 
         h = smaller(h, cm->h_max);
         /* the last step lands on the interval's end (forgiving a few ulp) */
         tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
-        J = cm->method->step(cm, s, tau, K, &trial);
+        J = method_step(cm)(cm, s, tau, K, &trial);
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
             tau = separation_within(cm, s, tau, K, &trial, &J);
@@ -98,7 +100,7 @@ static inline int controlled_internal_step(contact_model *cm, double remaining, 
     if (rejected > 0)
         h_next = smaller(h_next, tau);
     peak = peak_force_within(cm, s, tau, K, &trial);
-    accept_step(cm, cm->method, &trial);
+    accept_step(cm, &trial);
     s->h_next = h_next;
     count_contact_step(s, peak);
     *impulse += J;
@@ -118,7 +120,7 @@ static int internal_step(contact_model *cm, double h, double *impulse, unsigned 
     cm->s.steps++;
     if (cm->method->grid_step)
         return cm->method->grid_step(cm, h, impulse, stop_at);
-    return fixed_internal_step(cm, h, impulse, stop_at);
+    return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
 /* Whether every value of the state is finite, one by one. */

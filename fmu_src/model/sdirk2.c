@@ -71,7 +71,7 @@ static void springpot_second_stage(const contact_model *cm, double h, const damp
 }
 
 /* The modes after an accepted step of length h with stage rates z1, z2. */
-static void advance_modes(contact_model *cm, double h, double z1, double z2)
+void advance_modes(contact_model *cm, double h, double z1, double z2)
 {
     const contact_modes *m = modes_for_step(cm, h);
     size_t i;
@@ -138,23 +138,10 @@ double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h
     return sdirk_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }
 
-/* The damper's step, for the record: the fixed steps and the flight take
- * it inline (sdirk_step). */
-static double sdirk2_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
-{
-    return sdirk_step(cm, in, h, K, out);
-}
-
-/* Accepting a step: the compressed memory's modes follow its stages. */
-static void sdirk2_accept(contact_model *cm, const contact_state *trial)
-{
-    if (compressed_memory(cm))
-        advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
-}
-
 const contact_method_record sdirk2_method = {
     .method = CONTACT_METHOD_SDIRK2,
     .name = "sdirk2",
-    .step = sdirk2_step,
+    .dashpot_step = sdirk_dashpot_step,
+    .springpot_step = sdirk_springpot_step,
     .accept = sdirk2_accept,
 };
