@@ -211,8 +211,8 @@ static inline void sdirk2_accept(contact_model *cm, const contact_state *trial)
 
 /* Makes an SDIRK2 trial step the model's state, and its memory follow:
  * inline, for the fixed steps split at events (SDIRK2's alone) and every
- * method's steps out of contact; a call through the record there costs the
- * fixed steps more than the noise (docs/benchmarks.md). */
+ * method's steps out of contact; calls through the record there cost the
+ * fixed steps more than the noise (tests/instruction_counts.tsv). */
 static inline void accept_sdirk2_step(contact_model *cm, const contact_state *trial)
 {
     sdirk2_accept(cm, trial);

@@ -168,8 +168,8 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
 }
 
 /* The fixed step in the current contact: dt_max where it resolves the
- * impact (CONTACT_RESOLUTION steps in its turnaround time) or the grid is
- * uniform, else CONTACT_REFINED steps in that time: a step that does not
+ * impact (CONTACT_RESOLUTION steps in its turnaround time) or the method
+ * does not refine its steps, else CONTACT_REFINED steps in that time: a step that does not
  * resolve it is no one's choice, and a barely resolved one would show
  * SDIRK2's gain of energy in nearly elastic impacts, which grows with the
  * step like (h/t_c)^2.5 (docs/stability.md). Set where the onset speed or
@@ -177,5 +177,6 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
 void resolve_contact(contact_model *cm)
 {
     const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
-    cm->contact_step = cm->method->uniform_grid || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
+    cm->contact_step = !refines_fixed_steps(cm->method) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max
+                                                                                               : t / CONTACT_REFINED;
 }
