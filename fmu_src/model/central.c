@@ -6,7 +6,7 @@
  * the force of the step's start, so it is stable only while the dashpot's
  * relaxation lambda h < 2. Onset and separation are where x1 changes sign,
  * their times interpolated linearly; no step is split. */
-void central_internal_step(contact_model *cm, double h, double *impulse)
+static void central_internal_step(contact_model *cm, double h, double *impulse)
 {
     contact_state *s = &cm->s;
     const double x = s->x1 + s->x2, x1 = s->x1, t = s->t, F = s->F;
@@ -38,3 +38,19 @@ void central_internal_step(contact_model *cm, double h, double *impulse)
     if (s->in_contact && !(x1_next > 0.0))
         end_contact(s, t + h * x1 / (x1 - x1_next), s->v);
 }
+
+/* A step, and whether it ended with an event of the mask stop_at. */
+static int central_grid_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
+{
+    const int was_in_contact = cm->s.in_contact;
+    central_internal_step(cm, h, impulse);
+    return cm->s.in_contact != was_in_contact && (stop_at & (cm->s.in_contact ? CONTACT_ONSET : CONTACT_SEPARATION));
+}
+
+const contact_method_record central_method = {
+    .method = CONTACT_METHOD_CENTRAL,
+    .name = "central",
+    .uniform_grid = "central scheme's",
+    .fixed_steps = "the central differences (scheme = 2) take fixed steps of dt_max",
+    .grid_step = central_grid_step,
+};

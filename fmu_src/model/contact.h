@@ -83,6 +83,9 @@ enum contact_method {
     CONTACT_METHOD_RADAU_IIA = 5   /* error-controlled steps of the compressed springpot: Radau IIA (radau_iia.c) */
 };
 
+/* A method's record (contact_internal.h), one at the end of its file. */
+typedef struct contact_method_record contact_method_record;
+
 enum contact_scene {
     CONTACT_SCENE_DROP = 1,   /* the model owns a free striker */
     CONTACT_SCENE_DRIVEN = 2  /* the caller prescribes the indentation rate */
@@ -190,8 +193,7 @@ typedef struct {
     double k_fixed;   /* the spring's stiffness when it does not change with the step count */
     double inv_m;     /* 1/m of the striker the model moves; 0: velocity prescribed */
     double accel;     /* the striker's acceleration apart from the contact force */
-    enum contact_method method; /* contact_method(&p) */
-    int error_controlled;   /* tolerance > 0 where it applies: error-controlled steps */
+    const contact_method_record *method; /* the record of contact_method(&p) */
     double series_limit;    /* an implicit stage's root is its series while (beta^2 r) is below this (stage_root):
                                its error, 20 u^7, is then within 1e-3 of the tolerance; 0: to rounding */
     double peak_force_seen, peak_length; /* error control's cache: a force and its elastic indentation */

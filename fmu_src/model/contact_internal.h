@@ -16,7 +16,46 @@ const char *shown(double value, char text[32]);
 double spring_constant(const contact_params *p);
 double memory_kernel_floor(const contact_params *p);
 
+/* A method's record, one const at the end of the method's own file, as
+ * GSL's gsl_odeiv2_step_type: what the evolve loop, the events and the
+ * resolution checks ask of a method. contact_configure chooses it once
+ * (method_record); out of contact every method takes the damper's SDIRK2
+ * steps (free flight, a springpot's recovery). */
+typedef double (*contact_trial_step)(contact_model *cm, const contact_state *in, double h, double K,
+                                     contact_state *out);
+struct contact_method_record {
+    enum contact_method method;
+    const char *name;         /* contact_method_name */
+    int controls_error;       /* it chooses its steps by the tolerance (contact_error_controlled) */
+    const char *uniform_grid; /* whose uniform grid of dt_max it steps on whatever happens, for messages
+                                 ("central scheme's"), or NULL: its steps split at events */
+    const char *fixed_steps;  /* why it takes fixed steps whatever the tolerance, or NULL */
+    /* One trial step in contact of length h from *in with spring stiffness
+     * K into *out, returning the contact force's impulse: the dashpot's and
+     * the springpot's (NULL: not that damper's method, or a uniform grid,
+     * whose grid_step takes its own steps). */
+    contact_trial_step dashpot_step, springpot_step;
+    /* What accepting the trial step *trial makes of the method's memory
+     * (NULL: nothing, the state is all it carries). */
+    void (*accept)(contact_model *cm, const contact_state *trial);
+    /* Its dense output for the events: x1 over a contact step from *s to
+     * *trial as a polynomial of dense_degree in theta = tau / h (NULL: the
+     * events take the cubic through the step's ends). */
+    void (*dense_indentation)(const contact_state *s, const contact_state *trial, double *p);
+    int dense_degree;
+    /* One internal step of dt_max on the uniform grid: 0, 1 after an event
+     * of the mask stop_at (at the end of the step in which it happened), or
+     * -1 (NULL: the steps split at events, evolve.c). */
+    int (*grid_step)(contact_model *cm, double h, double *impulse, unsigned stop_at);
+};
+
+/* The records, at the ends of sdirk2.c, esdirk54.c, radau_iia.c,
+ * g1_history.c and central.c. */
+extern const contact_method_record sdirk2_method, esdirk54_method, radau_iia_method, g1_history_method,
+    central_method;
+
 /* method.c */
+const contact_method_record *method_record(const contact_params *p);
 const char *fixed_steps_only(const contact_params *p);
 
 /* resolution.c */
@@ -25,14 +64,15 @@ void resolve_contact(contact_model *cm);
 /* model.c */
 int memory_at_rest(const contact_model *cm);
 
-/* sdirk2.c, esdirk54.c and radau_iia.c: one step of length h from *in
- * with spring stiffness K into *out, returning the contact force's
- * impulse (sdirk_step below, by the damper); the compressed memory after
- * an accepted step. */
+/* sdirk2.c: SDIRK2's step of length h from *in with spring stiffness K
+ * into *out, returning the contact force's impulse, by the damper
+ * (sdirk_step below). */
 double sdirk_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void advance_modes(contact_model *cm, double h, double z1, double z2);
-double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+
+/* radau_iia.c, its record's step, memory and dense output (the tests take
+ * them one by one). */
 double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
 void radau_advance_modes(contact_model *cm, const contact_state *trial);
 void radau_indentation_polynomial(const contact_state *s, const contact_state *trial, double p[6]);
@@ -57,17 +97,8 @@ double force_at_turn(contact_model *cm, const contact_state *s, double h, double
 void begin_contact(contact_state *s, double t, double v);
 void end_contact(contact_state *s, double t, double v);
 
-/* g1_history.c and central.c: one step on the uniform grid. */
+/* g1_history.c */
 int history_reserve(contact_history *hist, size_t count);
-int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at);
-void central_internal_step(contact_model *cm, double h, double *impulse);
-
-/* Whether the parameters step on a uniform grid whatever happens. */
-static inline int uniform_grid(const contact_params *p)
-{
-    const enum contact_method method = contact_method(p);
-    return method == CONTACT_METHOD_G1_HISTORY || method == CONTACT_METHOD_CENTRAL;
-}
 
 /* The G1 ratio of the law on N intervals for x1^n = Gamma(n+1) D^(-(n-1)) x1
  * (docs/model.md §4): Gamma(N+n)/(Gamma(N) N^n). */
@@ -120,33 +151,20 @@ static inline double spring_stiffness(const contact_model *cm, long n_steps)
 static inline double larger(double a, double b) { return a > b ? a : b; }
 static inline double smaller(double a, double b) { return a < b ? a : b; }
 
-static inline int error_controlled(const contact_model *cm) { return cm->error_controlled; }
+static inline int error_controlled(const contact_model *cm) { return cm->method->controls_error; }
 
-/* Whether a step from *s is an error-controlled one: in contact. Out of
- * contact a recovering springpot takes recover's SDIRK2 steps, and the
- * onset search among them must take the same. */
-static inline int controlled_steps(const contact_model *cm, const contact_state *s)
+/* The method's trial step in contact, the damper's. */
+static inline contact_trial_step method_step(const contact_model *cm)
 {
-    return cm->error_controlled && s->in_contact;
+    return springpot(cm) ? cm->method->springpot_step : cm->method->dashpot_step;
 }
 
-/* Whether an error-controlled step from *s is Radau IIA's: the compressed
- * springpot's in contact. */
-static inline int radau_steps(const contact_model *cm, const contact_state *s)
+/* A trial step from *in: the method's in contact; out of contact every
+ * method takes SDIRK2's (a recovering springpot's steps, and the onset
+ * search among them). */
+static inline double trial_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return springpot(cm) && controlled_steps(cm, s);
-}
-
-/* An error-controlled step: the dashpot's ESDIRK, the compressed
- * springpot's Radau IIA in contact and SDIRK2 out of it. */
-static inline double controlled_step(contact_model *cm, const contact_state *in, double h, double K,
-                                     contact_state *out)
-{
-    if (!springpot(cm))
-        return esdirk_step(cm, in, h, K, out);
-    if (!radau_steps(cm, in))
-        return sdirk_step(cm, in, h, K, out);
-    return radau_step(cm, in, h, K, out);
+    return in->in_contact ? method_step(cm)(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
 }
 
 static inline double indentation_rate(const contact_model *cm, const contact_state *s)
@@ -183,15 +201,30 @@ static inline void carry_state(contact_state *to, const contact_state *from)
     memcpy(to, from, offsetof(contact_state, step));
 }
 
-/* Makes a trial step the model's state, and its memory follow. */
+/* What accepting an SDIRK2 step makes of the memory (its record's
+ * accept): the compressed memory's modes follow its stages. */
+static inline void sdirk2_accept(contact_model *cm, const contact_state *trial)
+{
+    if (compressed_memory(cm))
+        advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
+}
+
+/* Makes an SDIRK2 trial step the model's state, and its memory follow:
+ * inline, for the fixed steps split at events (SDIRK2's alone) and every
+ * method's steps out of contact; calls through the record there cost the
+ * fixed steps more than the noise (tests/instruction_counts.tsv). */
+static inline void accept_sdirk2_step(contact_model *cm, const contact_state *trial)
+{
+    sdirk2_accept(cm, trial);
+    carry_state(&cm->s, trial);
+}
+
+/* Makes a trial step of the model's method the model's state, and its
+ * memory follow. */
 static inline void accept_step(contact_model *cm, const contact_state *trial)
 {
-    if (compressed_memory(cm)) {
-        if (controlled_steps(cm, trial))
-            radau_advance_modes(cm, trial);
-        else
-            advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
-    }
+    if (cm->method->accept)
+        cm->method->accept(cm, trial);
     carry_state(&cm->s, trial);
 }
 

@@ -140,7 +140,7 @@ double onset_step(const contact_model *cm)
 static double recovery_fraction(const contact_model *cm)
 {
     const contact_state *s = &cm->s;
-    if (cm->error_controlled)
+    if (error_controlled(cm))
         return fmin(1.0 / 16.0, sqrt(cm->p.tolerance / 1.2e-6) / 16.0);
     return s->t_contact > 0.0 ? fmin(1.0 / 16.0, RECOVERY_STEPS * cm->h_max / s->t_contact) : 1.0 / 16.0;
 }
@@ -154,6 +154,6 @@ double recovery_step(const contact_model *cm, double remaining)
     const contact_state *s = &cm->s;
     const double since = s->impacts > 0 ? s->t - (s->t_onset + s->t_contact) : 0.0;
     const double f = recovery_fraction(cm);
-    const double least = !cm->error_controlled ? cm->h_max : s->h_next > 0.0 ? f * s->h_next : unscaled_step(cm);
+    const double least = !error_controlled(cm) ? cm->h_max : s->h_next > 0.0 ? f * s->h_next : unscaled_step(cm);
     return fmin(remaining, fmax(least, f * since));
 }

@@ -34,7 +34,7 @@ static const double esdirk_a[ESDIRK_STAGES][ESDIRK_STAGES] = {
  * relative to error_length, v's to error_speed. E_diss is the order-5
  * quadrature of F^2/c (SDIRK2's mean force times the travel is of order 2
  * only). */
-double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+static double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
     const int last = ESDIRK_STAGES - 1;
     damper_stage damper = {0.0, cm->inv_c};
@@ -83,3 +83,10 @@ double esdirk_step(contact_model *cm, const contact_state *in, double h, double 
     out->error = larger(error, fabs(V - V_embedded) / error_speed(in, out)) / cm->p.tolerance;
     return impulse;
 }
+
+const contact_method_record esdirk54_method = {
+    .method = CONTACT_METHOD_ESDIRK54,
+    .name = "esdirk54",
+    .controls_error = 1,
+    .dashpot_step = esdirk_step,
+};

@@ -6,12 +6,6 @@
 
 #include "contact_internal.h"
 
-/* A contact step of length h: error-controlled or fixed. */
-static double contact_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
-{
-    return error_controlled(cm) ? controlled_step(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
-}
-
 /* Free flight is the parabola x1 + v t + a t^2 / 2 (x1 <= 0: the gap). The
  * first time in [0, h] at which it enters the specimen, or -1 if it stays
  * out: either it is inside at h, or a concave parabola (a < 0) peaks inside
@@ -55,7 +49,7 @@ void fly(contact_model *cm, double tau, int touches)
 {
     contact_state trial;
     sdirk_step(cm, &cm->s, tau, 0.0, &trial);
-    accept_step(cm, &trial);
+    accept_sdirk2_step(cm, &trial);
     if (touches)
         touch(cm);
 }
@@ -89,13 +83,13 @@ static double event_time(contact_model *cm, const contact_state *s, double h, do
 {
     double lo = 0.0, hi = h, flo = event(cm, s), fhi = f_end;
     int i, side = 0;
-    *impulse = contact_step(cm, s, h, K, at);
+    *impulse = trial_step(cm, s, h, K, at);
     for (i = 0; i < 200 && fhi != 0.0 && hi - lo > precision * h; i++) {
         contact_state trial;
         double tau = i == 0 && guess > 0.0 && guess < 1.0 ? guess * h : (lo * fhi - hi * flo) / (fhi - flo), f, J;
         if (!(tau > lo && tau < hi))
             tau = 0.5 * (lo + hi);
-        J = contact_step(cm, s, tau, K, &trial);
+        J = trial_step(cm, s, tau, K, &trial);
         f = event(cm, &trial);
         if (f > 0.0) {
             lo = tau;
@@ -156,14 +150,15 @@ static double polynomial_root(const double *p, int degree)
 }
 
 /* x1 over an error-controlled step from *s to *end as a polynomial in
- * theta = tau / h, p[0..degree]: Radau IIA's collocation polynomial (its
- * dense output), or the cubic through the step's ends. Its degree. */
+ * theta = tau / h, p[0..degree]: the method's dense output (Radau IIA's
+ * collocation polynomial), or the cubic through the step's ends. Its
+ * degree. */
 static int indentation_polynomial(const contact_model *cm, const contact_state *s, const contact_state *end,
                                   double h, double p[6])
 {
-    if (radau_steps(cm, s)) {
-        radau_indentation_polynomial(s, end, p);
-        return 5;
+    if (cm->method->dense_indentation) {
+        cm->method->dense_indentation(s, end, p);
+        return cm->method->dense_degree;
     }
     indentation_cubic(cm, s, end, h, p);
     return 3;
@@ -238,7 +233,7 @@ double separation_within(contact_model *cm, const contact_state *s, double h, do
     int i;
     for (i = 0; i < 8; i++) {
         double rate, next;
-        *J = controlled_step(cm, s, tau, K, trial);
+        *J = method_step(cm)(cm, s, tau, K, trial);
         rate = indentation_rate(cm, trial);
         if (trial->error > 1.0)
             return tau;
@@ -264,12 +259,12 @@ double force_at_turn(contact_model *cm, const contact_state *s, double h, double
 {
     contact_state at;
     double J;
-    if (radau_steps(cm, s)) {
+    if (cm->method->dense_indentation) {
         double p[6];
         const int degree = indentation_polynomial(cm, s, end, h, p);
         at.F = spring_force(cm, K, larger(polynomial_at(p, degree, polynomial_turn(p, degree)), 0.0));
     } else if (error_controlled(cm))
-        contact_step(cm, s, event_guess(cm, s, end, h, 1) * h, K, &at);
+        trial_step(cm, s, event_guess(cm, s, end, h, 1) * h, K, &at);
     else
         event_time(cm, s, h, K, indentation_rate, indentation_rate(cm, end), 1e-15, -1.0, &at, &J);
     return at.F > end->F ? at.F : end->F;
@@ -309,7 +304,7 @@ double recover(contact_model *cm, double h, int *touches)
     else if (*touches) /* it starts on the surface: contact at once */
         h = 0.0;
     if (h > 0.0)
-        accept_step(cm, &trial);
+        accept_sdirk2_step(cm, &trial);
     if (*touches)
         touch(cm);
     return h;

@@ -1,7 +1,7 @@
 /* The evolve loop (docs/model.md §16): contact_advance steps the method
- * contact_method names over an interval, exact free flight out of contact,
- * fixed steps split at events or error-controlled ones in contact, and
- * leaves the state as it was where a step fails. */
+ * of the model's record over an interval, exact free flight out of
+ * contact, fixed steps split at events, error-controlled ones or a uniform
+ * grid's in contact, and leaves the state as it was where a step fails. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -13,11 +13,13 @@
  * a diverging state could reach it. */
 #define MAX_EVENTS_PER_STEP 1000
 
-/* One SDIRK step of length h, split at contact onset and separation.
- * Returns 0, 1 when it stopped early at an event of the mask stop_at (the
- * state's time tells where), or -1 when the events do not end (a diverging
- * state). Inline, as the controlled step below: contact_advance_until's
- * loop takes one at every internal step, and a call costs speed there. */
+/* One SDIRK2 step of length h, split at contact onset and separation (the
+ * fixed steps split at events are SDIRK2's alone, so its step and accept
+ * are taken inline here, not through its record). Returns 0, 1 when it
+ * stopped early at an event of the mask stop_at (the state's time tells
+ * where), or -1 when the events do not end (a diverging state). Inline, as
+ * the controlled step below: contact_advance_until's loop takes one at
+ * every internal step, and a call costs speed there. */
 static inline int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s, trial;
@@ -48,7 +50,7 @@ static inline int sdirk_internal_step(contact_model *cm, double h, double *impul
         if (separates)
             tau = locate_separation(cm, s, h, K, &trial, &J);
         peak = peak_force_within(cm, s, tau, K, &trial);
-        accept_step(cm, &trial);
+        accept_sdirk2_step(cm, &trial);
         count_contact_step(s, peak);
         *impulse += J;
         if (!separates)
@@ -81,7 +83,7 @@ static inline int controlled_internal_step(contact_model *cm, double remaining, 
         h = smaller(h, cm->h_max);
         /* the last step lands on the interval's end (forgiving a few ulp) */
         tau = h >= remaining * (1.0 - 1e-12) ? remaining : h;
-        J = controlled_step(cm, s, tau, K, &trial);
+        J = method_step(cm)(cm, s, tau, K, &trial);
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
             tau = separation_within(cm, s, tau, K, &trial, &J);
@@ -111,19 +113,13 @@ static inline int controlled_internal_step(contact_model *cm, double remaining, 
 }
 
 /* One internal step of a fixed-step method: 0, 1 after an event of the
- * mask stop_at (the central scheme stops at the end of the step in which it
+ * mask stop_at (a uniform grid stops at the end of the step in which it
  * happened), or -1. */
-static int internal_step(contact_model *cm, enum contact_method method, double h, double *impulse, unsigned stop_at)
+static int internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
-    int was_in_contact = cm->s.in_contact;
     cm->s.steps++;
-    if (method == CONTACT_METHOD_G1_HISTORY)
-        return g1_history_step(cm, impulse, stop_at);
-    if (method == CONTACT_METHOD_CENTRAL) {
-        central_internal_step(cm, h, impulse);
-        return cm->s.in_contact != was_in_contact
-               && (stop_at & (cm->s.in_contact ? CONTACT_ONSET : CONTACT_SEPARATION));
-    }
+    if (cm->method->grid_step)
+        return cm->method->grid_step(cm, h, impulse, stop_at);
     return sdirk_internal_step(cm, h, impulse, stop_at);
 }
 
@@ -186,8 +182,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
     const int64_t allowed = cm->max_steps > 0 ? cm->s.steps + cm->max_steps : INT64_MAX;
     double phi_start[CONTACT_MAX_MODES];
     double remaining = H, impulse = 0.0;
-    const enum contact_method method = cm->method;
-    const int uniform = method == CONTACT_METHOD_G1_HISTORY || method == CONTACT_METHOD_CENTRAL;
+    const int uniform = cm->method->uniform_grid != NULL;
     int stopped = 0, failed = 0, exceeded = 0;
     if (!(H > 0.0))
         return 0.0;
@@ -221,7 +216,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
                       || (cm->poll && cm->s.steps % CONTACT_POLL_STEPS == 0 && cm->poll(cm->poll_ctx));
             continue;
         }
-        if (method == CONTACT_METHOD_ESDIRK54 || method == CONTACT_METHOD_RADAU_IIA) {
+        if (cm->method->controls_error) {
             double advanced = 0.0;
             int status;
             cm->s.steps++;
@@ -237,7 +232,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
         h = remaining / n;
         steps = smaller(n, (double)(allowed - cm->s.steps));
         for (i = 0; i < steps && !stopped && !failed && (cm->s.in_contact || uniform); i++) {
-            int status = internal_step(cm, method, h, &impulse, stop_at);
+            int status = internal_step(cm, h, &impulse, stop_at);
             failed = status < 0;
             stopped = status > 0;
         }

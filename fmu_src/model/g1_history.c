@@ -65,7 +65,7 @@ static int g1_contact_events(contact_model *cm, const contact_state *before, uns
  * stage. Contact begins and ends at a step (no step is split), its times
  * interpolated linearly. 0, 1 after an event of the mask stop_at, or -1
  * when memory runs out. */
-int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
+static int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s;
     contact_history *hist = &cm->history;
@@ -162,3 +162,20 @@ int contact_check_history_span(const contact_params *p, double v, double m, doub
              name, shown(span, text[0]), shown(h, text[1]), CONTACT_G1_HISTORY_MAX, reach, name);
     return -1;
 }
+
+/* The record's grid step: the grid is dt_max's from t = 0, whatever the
+ * step the caller divided its advance into. */
+static int g1_grid_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
+{
+    (void)h;
+    return g1_history_step(cm, impulse, stop_at);
+}
+
+const contact_method_record g1_history_method = {
+    .method = CONTACT_METHOD_G1_HISTORY,
+    .name = "g1_history",
+    .uniform_grid = "full G1 history's",
+    .fixed_steps = "the springpot's full G1 history (memory = 1) steps on a uniform grid of dt_max (memory = 2, "
+                   "the compressed memory, takes error-controlled steps)",
+    .grid_step = g1_grid_step,
+};

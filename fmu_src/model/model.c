@@ -60,13 +60,12 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
     cm->inv_c = 1.0 / p->c;
     cm->k_fixed = p->law == CONTACT_LAW_HERTZ ? cm->k
                   : p->g1_nodes > 0 ? cm->k * g1_ratio(p->law, n, (double)p->g1_nodes) : 0.0;
-    cm->method = contact_method(p);
-    /* An error-controlled step needs its stages' roots well inside its
-     * tolerance, not to rounding. */
-    cm->error_controlled = contact_error_controlled(p);
+    cm->method = method_record(p);
     cm->h_max = contact_step_limit(p);
     resolve_contact(cm);
-    cm->series_limit = cm->error_controlled ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
+    /* An error-controlled step needs its stages' roots well inside its
+     * tolerance, not to rounding. */
+    cm->series_limit = error_controlled(cm) ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
     cm->peak_force_seen = -1.0;
     cm->peak_length = 0.0;
     cm->modes.modes = 0;

@@ -566,3 +566,13 @@ void radau_indentation_polynomial(const contact_state *s, const contact_state *t
             p[k] += radau_dense[k][i] * y[i];
     }
 }
+
+const contact_method_record radau_iia_method = {
+    .method = CONTACT_METHOD_RADAU_IIA,
+    .name = "radau_iia",
+    .controls_error = 1,
+    .springpot_step = radau_step,
+    .accept = radau_advance_modes,
+    .dense_indentation = radau_indentation_polynomial,
+    .dense_degree = STAGES,
+};

@@ -59,6 +59,10 @@ static double first_turnaround(const contact_params *p, double v, double m)
     return stopping_time(p, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
 }
 
+/* Whether the method shortens its fixed steps in a contact they do not
+ * resolve: neither a uniform grid nor error-controlled steps do. */
+static int refines_fixed_steps(const contact_method_record *m) { return !m->uniform_grid && !m->controls_error; }
+
 /* "dt_max = 0 (fixed steps of 1e-07 s)" or "dt_max = 2e-07": the step as given. */
 static const char *shown_step(const contact_params *p, char text[64])
 {
@@ -73,15 +77,15 @@ static const char *shown_step(const contact_params *p, char text[64])
 int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len)
 {
     const double t = first_turnaround(p, v, m);
+    const char *grid = method_record(p)->uniform_grid;
     char text[3][64];
-    if (!uniform_grid(p) || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+    if (!grid || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
         return 0;
     snprintf(msg, len,
              "%s is invalid with m = %s, v = %s: the spring stops the striker in %.3g s, which the %s uniform grid "
              "resolves only in steps of at most %.3g s (%d per stop); lower dt_max to that, or take scheme = 1 and "
              "memory = 2, whose steps shorten in contact",
-             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t,
-             contact_method(p) == CONTACT_METHOD_CENTRAL ? "central scheme's" : "full G1 history's", t / CONTACT_RESOLUTION,
+             shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t, grid, t / CONTACT_RESOLUTION,
              CONTACT_RESOLUTION);
     return -1;
 }
@@ -90,7 +94,7 @@ int contact_step_warning(const contact_params *p, double v, double m, char *msg,
 {
     const double t = first_turnaround(p, v, m);
     char text[3][64];
-    if (contact_method(p) != CONTACT_METHOD_SDIRK2 || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+    if (!refines_fixed_steps(method_record(p)) || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
         return 0;
     snprintf(msg, len,
              "%s does not resolve the impact of m = %s at v = %s: the spring stops the striker in %.3g s, less "
@@ -164,8 +168,8 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
 }
 
 /* The fixed step in the current contact: dt_max where it resolves the
- * impact (CONTACT_RESOLUTION steps in its turnaround time) or the grid is
- * uniform, else CONTACT_REFINED steps in that time: a step that does not
+ * impact (CONTACT_RESOLUTION steps in its turnaround time) or the method
+ * does not refine its steps, else CONTACT_REFINED steps in that time: a step that does not
  * resolve it is no one's choice, and a barely resolved one would show
  * SDIRK2's gain of energy in nearly elastic impacts, which grows with the
  * step like (h/t_c)^2.5 (docs/stability.md). Set where the onset speed or
@@ -173,5 +177,6 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
 void resolve_contact(contact_model *cm)
 {
     const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
-    cm->contact_step = uniform_grid(&cm->p) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
+    cm->contact_step = !refines_fixed_steps(cm->method) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max
+                                                                                               : t / CONTACT_REFINED;
 }

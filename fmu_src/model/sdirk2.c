@@ -137,3 +137,11 @@ double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h
 {
     return sdirk_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }
+
+const contact_method_record sdirk2_method = {
+    .method = CONTACT_METHOD_SDIRK2,
+    .name = "sdirk2",
+    .dashpot_step = sdirk_dashpot_step,
+    .springpot_step = sdirk_springpot_step,
+    .accept = sdirk2_accept,
+};
