@@ -16,8 +16,11 @@ import time
 
 import pytest
 
+import fraccontact
+from closed_forms import EPS
 from fmu_driver import C, K, M, run_impact
 from fraccontact.scipy_contact import solve_drop
+from test_fmu_features import reference
 from test_fmu_physics import reference_drop
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -354,7 +357,34 @@ def test_an_underflowing_indentation_is_no_separation(method):
     assert r["impacts"] == 0 and r["end"]["eps"] == 0 and r["stopped"] == "t_end" and r["end"]["v"] == 5e-324
 
 
-# ---------------------------------------------------------------- issue 23: limits, Ctrl-C, rows' cost, options
+# ---------------------------------------------------------------- an overdamped contact at rest
+
+def test_an_overdamped_contact_rests_instead_of_ending_at_a_denormal_eps():
+    """A linear spring k = 3.3e8 N/m in series with c = 6080 N s/m under
+    0.74 kg is overdamped ((k/c)^2 > 4 k/m): force and speed decay
+    together, and x1 never falls through 0 on the way out. It 'ended' at
+    73 ms with eps 5.5e-317 when x1 underflowed; now the run says it rests:
+    no impact finished, the force and the speed below rounding of their
+    peak and onset values, the momentum all in the dent (m v0 = c x2)."""
+    r = fraccontact.impact(spring_exponent=1.0)
+    assert r.stopped == "resting" and r.impacts == 0 and math.isnan(r.eps) and r.end.eps == 0.0
+    assert abs(r.end.v) <= EPS * V0
+    assert r.end.x2 == pytest.approx(M * V0 / 6080.0, rel=1e-12, abs=0)  # rounding over ~37 000 steps
+    for mode in ((), ("--reference",)):
+        out = solve_json("--spring-exponent", 1, *mode)
+        assert out["stopped"] == "resting" and out["eps"] is None and out["impacts"] == 0, mode
+
+
+def test_a_small_true_rebound_still_ends_its_impact():
+    """The Hertz law with c = 100 rebounds at eps 2.4e-7 after 0.108 s
+    (GSL agrees): a real separation, not a rest."""
+    r = fraccontact.impact(c=100.0, law="hertz")
+    ref = reference("--c", 100)
+    assert r.stopped == "impacts" and r.eps == pytest.approx(ref["eps"], rel=1e-4, abs=0)
+
+
+
+# ---------------------------------------------------------------- limits, Ctrl-C, rows' cost, options
 
 def solve_limited(*args, seconds=30, cwd=None):
     """The solver with at most 2 GB of address space and `seconds` of time:
