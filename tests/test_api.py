@@ -43,7 +43,7 @@ def warned(run):
     return caught
 
 
-# --- item 7: a value without effect warns with the library's message -------
+# --- a value without effect warns with the library's message ---------------
 
 @pytest.mark.parametrize("params", [dict(E_s=2e9), dict(damper_order=0.3), dict(damper=2, c=7000.0),
                                     dict(law="hertz", memory=1, damper=2, memory_tolerance=1e-8)])
@@ -75,7 +75,7 @@ def test_values_with_effect_do_not_warn():
     no_warning(lambda: fraccontact.simulate(output_interval=1e-4, law="hertz", tolerance=1e-6))
 
 
-# --- items 9 and 21: integer parameters, words, and messages that name -----
+# --- integer parameters, words, and messages that name ---------------------
 
 @pytest.mark.parametrize("params, says", [
     (dict(law=np.array([1.0, 1.5])), r"case \(1,\): law = 1.5 is invalid: it must be a whole number"),
@@ -178,7 +178,7 @@ def test_a_batch_shares_a_springpots_kernel_only_between_runs_alike():
             alone.F_peak, alone.eps, alone.x2_end, alone.steps), case
 
 
-# --- item 24: one shape of result ------------------------------------------
+# --- one shape of result ---------------------------------------------------
 
 RUN_FIELDS = ["t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss", "per_impact", "end",
               "stopped", "impacts", "steps", "k", "method"]
@@ -252,7 +252,7 @@ def test_the_readmes_python_section_runs_and_tells_the_shape():
         assert float(re.search(r"more than (?:the )?(\S+)", str(refused.value)).group(1).rstrip(";,")) == limit
 
 
-# --- item 1: rows beyond what the machine holds, refused up front -----------
+# --- rows beyond what the machine holds, refused up front -------------------
 
 def test_a_series_too_long_for_memory_is_refused_up_front():
     """output_interval 1e-12 over a 1 s run asks for 1e12 rows (24 GB were
@@ -267,7 +267,7 @@ def test_a_series_too_long_for_memory_is_refused_up_front():
     assert "output_interval" in run.stdout and "1e-12" in run.stdout, run.stdout
 
 
-# --- item 4: Ctrl-C stops a long call; a terminal sees its progress ---------
+# --- Ctrl-C stops a long call; a terminal sees its progress -----------------
 
 # The h20 impact in 6.6e8 internal steps: under the library's limit of 1e9,
 # so accepted, and about a minute and a half of work.

@@ -1,4 +1,4 @@
-"""F_avg_next, the coupling for Jacobi masters (issue 14, part 1): a master
+"""F_avg_next, the coupling for Jacobi masters: a master
 that steps the contact and the striker from the values of the last point
 and feeds the striker F_avg_next reproduces the monolithic drop test.
 
@@ -93,7 +93,7 @@ def step_counts(log):
 
 @pytest.mark.parametrize("H", [1e-6, 1e-5, 1e-4, 1e-3])
 def test_a_jacobi_master_is_the_monolithic_drop_test(slave, library, H):
-    """Issue 14's target is 1e-3 in F_peak and eps at H = 1e-4 s; the
+    """The target is 1e-3 in F_peak and eps at H = 1e-4 s; the
     coupling is exact: the proxy striker is the striker, and F_avg_next
     gives it its impulse in the step it acts (the first step's a step late,
     which moves the striker's position, which the contact does not use).

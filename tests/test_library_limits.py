@@ -87,7 +87,7 @@ def fc_run_in_child(interval, seconds=60, **values):
     return in_child(RUN_IN_CHILD.format(values=values, interval=interval), seconds)
 
 
-# ---------------------------------------------------------------- item 1: rows beyond what a run keeps
+# ---------------------------------------------------------------- rows beyond what a run keeps
 
 
 @pytest.mark.parametrize("values, interval, rows", [
@@ -145,7 +145,7 @@ def test_simulate_refuses_an_output_interval_beyond_the_limit():
     assert r.startswith("output_interval = 1e-12 is invalid: the time series would hold at least"), r
 
 
-# ---------------------------------------------------------------- item 4: steps beyond the limit
+# ---------------------------------------------------------------- steps beyond the limit
 
 
 @pytest.mark.parametrize("values, steps", [
@@ -188,7 +188,7 @@ def test_impact_refuses_a_run_of_more_than_a_billion_steps():
     assert r.startswith("dt_max = 1e-13 is invalid: the run would take at least 1.23e+10 internal steps"), r
 
 
-# ---------------------------------------------------------------- item 4: progress and stop
+# ---------------------------------------------------------------- progress and stop
 
 
 CASES = {   # each runs for seconds to minutes, and must stop within STOP_WITHIN of being asked
@@ -314,7 +314,7 @@ def test_a_stopped_run_leaks_nothing():
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 50_000  # kB
 
 
-# ---------------------------------------------------------------- item 6: the springpot's rows
+# ---------------------------------------------------------------- the springpot's rows
 
 
 def rows_and_impacts(interval, **values):
