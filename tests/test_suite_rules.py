@@ -66,17 +66,19 @@ def issue_numbers(lines, filename):
     return [f"{filename}:{i}: {line.strip()[:100]}" for i, line in enumerate(lines, 1) if ISSUE_NUMBER.search(line)]
 
 
+def is_script(path):
+    with path.open("rb") as f:
+        return f.read(2) == b"#!"
+
+
 def sources():
     """The tracked source files: (name, lines)."""
     names = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
     for name in names:
         path = ROOT / name
-        if not path.is_file():
-            continue
-        text = path.read_text(errors="replace")
-        if name.endswith(SOURCE_SUFFIXES) or pathlib.PurePosixPath(name).name == "CMakeLists.txt" \
-                or text.startswith("#!"):
-            yield name, text.splitlines()
+        if path.is_file() and (name.endswith(SOURCE_SUFFIXES) or pathlib.PurePosixPath(name).name == "CMakeLists.txt"
+                               or is_script(path)):
+            yield name, path.read_text(errors="replace").splitlines()
 
 
 def test_the_issue_number_check_finds_what_it_looks_for():
