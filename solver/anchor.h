@@ -1,4 +1,4 @@
-/* The speed anchor of issue 14: one drop-test impact of docs/model.md §2 (the
+/* The speed anchor: one drop-test impact of docs/model.md §2 (the
  * closed-form Hertz spring in series with a dashpot, no gravity) integrated
  * by GSL's rk8pd as a competent user would script it: adaptive steps, the
  * force peak and the separation located by secant iterations on single

@@ -25,7 +25,7 @@
  *                                     impact (batches alternated, medians),
  *                                     steps and the impact's figures
  *   fraccontact-bench anchor K C M V T_END RTOL [REPEATS]
- *                                     the speed anchor of issue 14 (anchor.h):
+ *                                     the speed anchor (anchor.h):
  *                                     one impact by GSL's rk8pd as a user would
  *                                     script it, its figures, right-hand sides,
  *                                     steps and CPU per impact (median of
@@ -191,7 +191,7 @@ static int bench_batch(size_t N, int law, double dt_max)
 
 /* ------------------------------------------------------------ springpot */
 
-/* The springpot of the issue-12 benchmarks: alpha 0.5, c_alpha 3e5 (the
+/* The springpot of the benchmarks: alpha 0.5, c_alpha 3e5 (the
  * defaults: as damping as the h20 dashpot at the impact's frequency). */
 static void springpot_params(contact_params *p, int memory, double dt_max)
 {

@@ -1,4 +1,4 @@
-# build/headform.ssp and build/bumper.ssp: the crash scenes (issue 25) as SSP
+# build/headform.ssp and build/bumper.ssp: the crash scenes (docs/scenes.md) as SSP
 # 1.0, their SSD from ssp/ with the step of fraccontact/scenes/systems.py and
 # their SSV files written from fraccontact/scenes/parameters.py, both by
 # fraccontact.scenes.systems, with the FMUs of this build; the Python package

@@ -1,4 +1,4 @@
-"""The speed as a tested promise (issue 35, item 22): the instructions a few
+"""The speed as a tested promise: the instructions a few
 short runs execute, counted by valgrind's callgrind, against the counts
 recorded in tests/instruction_counts.tsv.
 

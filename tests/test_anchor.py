@@ -1,4 +1,4 @@
-"""fraccontact-bench anchor (issue 14): GSL's rk8pd scripted as a user would,
+"""fraccontact-bench anchor: GSL's rk8pd scripted as a user would,
 at the loosest tolerance that meets 1e-6, against fraccontact-solve's
 independent reference (its own event bracketing, at rtol 1e-14)."""
 

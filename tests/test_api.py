@@ -1,9 +1,14 @@
-"""The Python API's contract (issue 23): values without effect warn, integer
+"""The Python API's contract: values without effect warn, integer
 parameters take whole numbers or their words and nothing truncated, every
 bad value is named with its case, and impact, impacts and simulate return
-one shape of result."""
+one shape of result (an empty batch's too, and a batch's per_impact None);
+a striker that never reaches the specimen has one documented answer (no
+impact, a warning naming v, g and gap0) in the library, the solver and the
+FMU, and one that arrives later (gravity) is no such case."""
 
 import dataclasses
+import json
+import math
 import os
 import pty
 import re
@@ -18,7 +23,10 @@ import numpy as np
 import pytest
 
 import fraccontact
+from closed_forms import EPS
+from doc_pages import section
 from fraccontact import model
+from test_solver import SOLVE
 
 
 def no_warning(run):
@@ -35,7 +43,7 @@ def warned(run):
     return caught
 
 
-# --- item 7: a value without effect warns with the library's message -------
+# --- a value without effect warns with the library's message ---------------
 
 @pytest.mark.parametrize("params", [dict(E_s=2e9), dict(damper_order=0.3), dict(damper=2, c=7000.0),
                                     dict(law="hertz", memory=1, damper=2, memory_tolerance=1e-8)])
@@ -67,7 +75,7 @@ def test_values_with_effect_do_not_warn():
     no_warning(lambda: fraccontact.simulate(output_interval=1e-4, law="hertz", tolerance=1e-6))
 
 
-# --- items 9 and 21: integer parameters, words, and messages that name -----
+# --- integer parameters, words, and messages that name ---------------------
 
 @pytest.mark.parametrize("params, says", [
     (dict(law=np.array([1.0, 1.5])), r"case \(1,\): law = 1.5 is invalid: it must be a whole number"),
@@ -170,7 +178,7 @@ def test_a_batch_shares_a_springpots_kernel_only_between_runs_alike():
             alone.F_peak, alone.eps, alone.x2_end, alone.steps), case
 
 
-# --- item 24: one shape of result ------------------------------------------
+# --- one shape of result ---------------------------------------------------
 
 RUN_FIELDS = ["t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss", "per_impact", "end",
               "stopped", "impacts", "steps", "k", "method"]
@@ -244,7 +252,7 @@ def test_the_readmes_python_section_runs_and_tells_the_shape():
         assert float(re.search(r"more than (?:the )?(\S+)", str(refused.value)).group(1).rstrip(";,")) == limit
 
 
-# --- item 1: rows beyond what the machine holds, refused up front -----------
+# --- rows beyond what the machine holds, refused up front -------------------
 
 def test_a_series_too_long_for_memory_is_refused_up_front():
     """output_interval 1e-12 over a 1 s run asks for 1e12 rows (24 GB were
@@ -259,7 +267,7 @@ def test_a_series_too_long_for_memory_is_refused_up_front():
     assert "output_interval" in run.stdout and "1e-12" in run.stdout, run.stdout
 
 
-# --- item 4: Ctrl-C stops a long call; a terminal sees its progress ---------
+# --- Ctrl-C stops a long call; a terminal sees its progress -----------------
 
 # The h20 impact in 6.6e8 internal steps: under the library's limit of 1e9,
 # so accepted, and about a minute and a half of work.
@@ -333,3 +341,121 @@ def test_a_short_call_draws_nothing_on_a_terminal():
     assert p.wait(timeout=60) == 0
     assert terminal_text(ours) == ""
     os.close(ours)
+
+
+# --- a striker that never reaches the specimen: no impact, said so ---------
+
+NEVER = "the striker never reaches the specimen"
+
+
+def result_and_warnings(run):
+    """What run returns and the messages of the warnings it gives."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run()
+    return result, [str(w.message) for w in caught if issubclass(w.category, fraccontact.ParameterWarning)]
+
+
+# (v, g, gap0): the flight -gap0 + v t + g t^2 / 2 never reaches 0, and why
+NEVER_ARRIVES = [(-1.0, 0.0, 0.0),      # moving away
+                 (0.0, 0.0, 0.0),       # at rest on the surface, nothing pushes it
+                 (0.0, 0.0, 1e-3),      # at rest in the gap
+                 (0.1, -9.81, 1e-3)]    # towards it, but turned back in the gap: v^2 = 0.01 < 2 |g| gap0 = 0.0196
+# The same striker where it does arrive: gravity brings one moving away back,
+# and a faster one crosses the gap against a deceleration (0.04 > 0.0196).
+ARRIVES = [(-0.5, 9.81, 1e-3), (0.0, 9.81, 1e-3), (0.2, -9.81, 1e-3)]
+
+
+def onset(v, g, gap0):
+    """The first root t > 0 of -gap0 + v t + g t^2 / 2, and the speed there."""
+    speed = math.sqrt(v * v + 2 * g * gap0)
+    return (speed - v) / g, speed
+
+
+@pytest.mark.parametrize("v, g, gap0", NEVER_ARRIVES)
+def test_a_striker_that_never_arrives_warns_and_has_no_impact(v, g, gap0):
+    """The documented answer (docs/model.md §9): a warning naming v, g and
+    gap0; the run stops at once (receding) with no impact; the first
+    impact's figures NaN; the FMU's outputs F_peak, eps, t_contact, E_diss 0."""
+    r, messages = result_and_warnings(lambda: fraccontact.impact(v=v, g=g, gap0=gap0))
+    assert len(messages) == 1 and messages[0].startswith(f"v = {v:g} with g = {g:g} and gap0 = {gap0:g}: {NEVER}")
+    assert messages[0] == fraccontact.warning(v=v, g=g, gap0=gap0)
+    assert (r.stopped, r.impacts, r.steps, r.per_impact) == ("receding", 0, 0, [])
+    assert all(math.isnan(r[name]) for name in fraccontact.model.IMPACT_FIGURES)
+    assert (r.end.F_peak, r.end.eps, r.end.t_contact, r.end.E_diss, r.end.v) == (0.0, 0.0, 0.0, 0.0, v)
+
+
+@pytest.mark.parametrize("v, g, gap0", ARRIVES)
+def test_a_striker_that_arrives_later_does_not_warn(v, g, gap0):
+    """Its onset is the flight's root (the model's exact parabola: to a few
+    roundings, 4 ulp) and it has its impact."""
+    r, messages = result_and_warnings(lambda: fraccontact.impact(v=v, g=g, gap0=gap0))
+    t, speed = onset(v, g, gap0)
+    assert messages == [] and r.impacts == 1 and r.F_peak > 0
+    assert r.t_onset == pytest.approx(t, rel=4 * EPS, abs=0)
+    assert r.v_onset == pytest.approx(speed, rel=4 * EPS, abs=0)
+
+
+def test_a_batch_with_strikers_that_never_arrive_warns_once_and_runs_the_others():
+    a, messages = result_and_warnings(lambda: fraccontact.impacts(v=np.array([0.5, -1.0, 0.0])))
+    assert messages == [f"case (1,): {fraccontact.warning(v=-1.0)} (2 of 3 cases have a value without effect)"]
+    assert list(a.impacts) == [1, 0, 0] and list(a.stopped) == ["impacts", "receding", "receding"]
+    assert a.F_peak[0] > 0 and np.isnan(a.F_peak[1:]).all() and (a.end.F_peak[1:] == 0).all()
+
+
+def test_the_solver_warns_and_reports_no_impact():
+    """Exit 0, the library's warning on stderr, the JSON's figures null and
+    its end the FMU's outputs."""
+    done = subprocess.run([SOLVE, "--v", "-1", "--json"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == f"fraccontact-solve: warning: {fraccontact.warning(v=-1.0)}\n"
+    r = json.loads(done.stdout)
+    assert all(r[name] is None for name in fraccontact.model.IMPACT_FIGURES)
+    assert (r["stopped"], r["impacts"], r["per_impact"]) == ("receding", 0, [])
+    assert (r["end"]["F_peak"], r["end"]["eps"], r["end"]["E_diss"]) == (0, 0, 0)
+
+
+def test_the_solver_says_nothing_of_a_striker_gravity_brings_back():
+    done = subprocess.run([SOLVE, "--v", "-0.5", "--g", "9.81", "--gap0", "1e-3", "--json"], capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert json.loads(done.stdout)["impacts"] == 1
+
+
+def test_the_fmu_warns_at_initialization_and_outputs_no_impact(slave):
+    """The drop test's FMU: the same sentence as fmi2Warning when it leaves
+    initialization; then its flight, F_peak and eps staying 0."""
+    s = slave(v=-1.0)
+    assert [(status, message) for status, _, message in s.log if NEVER in message] == \
+        [(1, fraccontact.warning(v=-1.0))]  # fmi2Warning
+    for _ in range(10):
+        s.step(1e-4)
+    assert (s.get("F_peak"), s.get("eps"), s.get("E_diss"), s.get("F")) == (0.0, 0.0, 0.0, 0.0)
+    assert s.get("x") == pytest.approx(-1e-3, rel=4 * EPS, abs=0)  # x = v t, exact flight over 1 ms
+
+
+def test_the_fmu_says_nothing_where_gravity_brings_the_striker_back(slave):
+    s = slave(v=-0.5, g=9.81, gap0=1e-3)
+    assert not [message for _, _, message in s.log if NEVER in message]
+    for _ in range(130):  # the onset at 0.104 s (onset()), the impact over by 0.13 s
+        s.step(1e-3)
+    assert s.get("F_peak") > 0 and s.get("eps") > 0
+
+
+def test_the_driven_scene_does_not_warn(slave):
+    """The caller owns its striker there: v may change at any step."""
+    s = slave(scene=2, m=0.0, v=-1.0)
+    assert not [message for _, _, message in s.log if NEVER in message]
+
+
+# --- the batch's result ------------------------------------------------------
+
+def test_an_empty_batch_keeps_methods_type():
+    assert fraccontact.impacts(c=np.array([])).method.dtype.kind == fraccontact.impacts(c=np.array([5e3])).method.dtype.kind == "U"
+
+
+def test_the_batchs_per_impact_is_none_as_the_docs_say():
+    assert fraccontact.impacts(c=np.array([5e3])).per_impact is None
+    prose = " ".join(section("In Python: the `fraccontact` package").split())
+    assert "`impacts()` gives the same `Run` with every figure an array of the broadcast shape and `per_impact` " \
+           "`None`" in prose

@@ -1,5 +1,5 @@
 """The figures of the README and the guides of docs/ (tests/doc_pages.py),
-measured (issue 23, items 27 to 30). Each test finds its sentence on
+measured. Each test finds its sentence on
 whichever page holds it, reads the figure as written there, and measures it
 on this build: a figure that drifts, or a sentence reworded without its test,
 fails here. Figures are compared at the precision they are stated with:
@@ -57,7 +57,7 @@ def assert_figure(measured, stated, what):
     assert float(f"{measured:.{digits - 1}e}") == value(stated), f"{what}: measured {measured:.3g}, README says {stated}"
 
 
-# --- item 27: the FMU state's size -----------------------------------------------
+# --- the FMU state's size --------------------------------------------------------
 
 def test_the_readme_state_sizes_are_the_fmus(slave):
     """fmi2SerializedFMUstateSize through fmpy, at the defaults (the
@@ -71,7 +71,7 @@ def test_the_readme_state_sizes_are_the_fmus(slave):
     assert (size(damper=2), size()) == (springpot, dashpot)
 
 
-# --- item 28: alpha = 1 against the dashpot ----------------------------------------
+# --- alpha = 1 against the dashpot -------------------------------------------------
 
 def drop(stop, **start):
     """Every output of the FMU's drop test at every 10 us."""
@@ -107,7 +107,7 @@ def test_alpha_1_is_the_dashpot_as_the_readme_says(law):
     assert_bound(worst, number(later), "eps, x2, E_diss over the bounces")
 
 
-# --- item 29: the communication step ------------------------------------------------
+# --- the communication step ---------------------------------------------------------
 
 def figures_at(H, law, stop=4e-3, **start):
     """F_peak, eps, x2, E_diss after the impact, as `fmpy simulate
@@ -182,7 +182,7 @@ def test_a_masters_step_computed_from_its_clock_cuts_no_extra_internal_step(slav
         assert clock.get(name) == pytest.approx(exact.get(name), rel=1e-12, abs=0), name
 
 
-# --- item 30: stale figures ---------------------------------------------------------
+# --- stale figures ------------------------------------------------------------------
 
 def table_rows(text, first_cell):
     """Cells of the markdown table rows whose first cell contains first_cell."""

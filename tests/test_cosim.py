@@ -73,7 +73,7 @@ for H in (1e-4, 2e-4, 5e-4):
 
 
 def test_each_fmu_is_extracted_once_and_removed_at_exit(tmp_path):
-    """Issue 10, item 15: one folder per FMU file while the process runs
+    """One folder per FMU file while the process runs
     (not one per instance: hundreds per study), none left after it."""
     code = COUNT_EXTRACTIONS.format(contact=str(CONTACT), striker=str(STRIKER))
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -191,7 +191,7 @@ def test_bad_records_are_refused_with_the_reason(t, a, call, message):
         crash.hic(t, a, 0.015) if call == "hic" else crash.filtered(t, a)
 
 
-# --- issue 35, item 8: a fine record's HIC at a bounded cost ---------------
+# --- a fine record's HIC at a bounded cost -----------------------------------
 
 def test_a_fine_record_is_searched_on_the_100_khz_grid(monkeypatch):
     """crashmetrics' search grows as the samples times the window's samples

@@ -3,7 +3,7 @@
 with and without noise; unreachable pairs are refused with a message; the
 paper's h20 row is fitted; hostile files and arguments get one line and exit
 status 2 before the model runs; residuals with a shape are warned about; the
-output carries units and errors. The springpot (issue 12, item 7): k,
+output carries units and errors. The springpot: k,
 c_alpha and alpha recovered from a curve, from several curves and from drop
 tests at several heights, within their standard errors; one drop test (or
 repeats of one height) reported as not identifiable, with a family of
@@ -106,7 +106,7 @@ def test_the_command_line_says_why_it_cannot(tmp_path):
     assert done.returncode == 2 and "not reachable" in done.stderr
 
 
-# Issue 10, item 8: a trigger offset. The user's file had t = 0 50 us before the contact onset.
+# A trigger offset. The user's file had t = 0 50 us before the contact onset.
 
 SHIFT, STEP = 50e-6, 2e-6
 
@@ -201,7 +201,7 @@ def test_residuals_with_a_shape_are_warned_about_and_noise_is_not(command_line_f
     assert not r["residuals_noise_like"] and r["residual_autocorrelation"] > 3 / math.sqrt(800)
 
 
-# Issue 10, item 9: every bad input is one line on stderr and exit status 2, before the model runs.
+# Every bad input is one line on stderr and exit status 2, before the model runs.
 
 def with_row(t, F, i, row):
     """The curve as text, data row i (0-based) replaced by the text row."""
@@ -301,7 +301,7 @@ def test_a_bad_plot_path_is_refused_before_fitting(measured, refuse, tmp_path, p
     assert status == 2 and err.count("\n") == 1 and says in err, err
 
 
-# Issue 10, item 10: values with units, and beside them their standard errors.
+# Values with units, and beside them their standard errors.
 
 def value_and_error(text, name, unit):
     """The printed value and error of 'name = value ± error unit'; the value must be given to the second
@@ -347,7 +347,7 @@ def test_help_gives_every_option_a_unit_and_the_residual_criterion():
     assert "r1 > 3/sqrt(n)" in parser.format_help()
 
 
-# Issue 12, item 7: the springpot (k, c_alpha, alpha), joint fits, identifiability.
+# The springpot (k, c_alpha, alpha), joint fits, identifiability.
 #
 # The truth: k = 3e8, alpha = 0.6, and c_alpha the springpot whose impedance at 1/t_c (t_c the elastic
 # Hertz contact time at h20) equals a dashpot of 6000 N s/m: c_alpha = 6000 t_c^(alpha - 1) = 86 254 N s^0.6/m,

@@ -127,7 +127,7 @@ def assert_stepping_matches_the_default(s):
 
 
 # A damper's parameter set while the other damper is selected, and what
-# the warning must say (issue 12): the value has no effect, and why.
+# the warning must say: the value has no effect, and why.
 UNUSED_DAMPER_VALUES = [
     ({"damper_order": 0.3}, "damper_order = 0.3", "damper = 1"),
     ({"c_alpha": 1e5}, "c_alpha = 100000", "damper = 1"),

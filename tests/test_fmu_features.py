@@ -1,5 +1,5 @@
 """FMU features checked through the FMU against what is known independently
-of the C code (issue 15, item 5): gravity and the initial gap against free
+of the C code: gravity and the initial gap against free
 fall, the driven scene's proxy striker under gravity, the extrapolated G1
 law (law 3) at odd N, the force peak located inside a coarse step, the
 `contact` flag's transitions, and k derived from the materials.

@@ -1,4 +1,4 @@
-"""F_avg_next, the coupling for Jacobi masters (issue 14, part 1): a master
+"""F_avg_next, the coupling for Jacobi masters: a master
 that steps the contact and the striker from the values of the last point
 and feeds the striker F_avg_next reproduces the monolithic drop test.
 
@@ -93,7 +93,7 @@ def step_counts(log):
 
 @pytest.mark.parametrize("H", [1e-6, 1e-5, 1e-4, 1e-3])
 def test_a_jacobi_master_is_the_monolithic_drop_test(slave, library, H):
-    """Issue 14's target is 1e-3 in F_peak and eps at H = 1e-4 s; the
+    """The target is 1e-3 in F_peak and eps at H = 1e-4 s; the
     coupling is exact: the proxy striker is the striker, and F_avg_next
     gives it its impulse in the step it acts (the first step's a step late,
     which moves the striker's position, which the contact does not use).
@@ -422,3 +422,30 @@ def test_error_controlled_steps_under_a_jacobi_master(slave):
     assert r["F_peak"] == pytest.approx(s.get("F_peak"), rel=ROUNDING, abs=0)
     assert -r["v_end"] / V0 == pytest.approx(s.get("eps"), rel=ROUNDING, abs=0)
     assert r["counts"] == (13, 1)
+
+
+# ------------------------------------ F_avg_next with coupling left at 1
+
+def test_a_jacobi_master_with_coupling_left_at_1(slave):
+    """scene 2, law 2, the h20 striker 0.1 mm from the specimen, H = 1 ms,
+    the master feeding F_avg_next and coupling left at 1: the contact
+    begins inside the first step, and the proxy restarted from the
+    master's v, which had not yet received that step's impulse (eps 1.95,
+    energy created). The FMU sees that the master's v is its own motion
+    read as a Jacobi master's and follows it, warning once: the rebound is
+    the library's drop test from the same gap, to rounding over its
+    13 000 steps, and the striker gets back at most the energy it brought."""
+    H, t_end = 1e-3, 4e-3
+    library = fraccontact.impact(law=2, gap0=1e-4)
+    c = slave(start=False, law=2, scene=2, v=V0, m=M, gap0=1e-4)
+    c.start()
+    v, F_next = V0, c.get("F_avg_next")
+    for n in range(round(t_end / H)):
+        c.set(v=v)
+        c.step(H)
+        v -= F_next / M * H
+        F_next = c.get("F_avg_next")
+    assert -v / V0 == pytest.approx(library.eps, rel=4 * EPS * library.steps, abs=0)
+    assert c.get("eps") == pytest.approx(library.eps, rel=4 * EPS * library.steps, abs=0)
+    warnings = [m for status, _, m in c.log if status == 1 and "coupling = 1" in m]
+    assert len(warnings) == 1 and "coupling = 2" in warnings[0]

@@ -1,6 +1,7 @@
-"""What libfraccontact refuses up front (issue 23, items 1 and 4), how a
-long run is stopped (its progress callback), and what the springpot's rows
-cost (item 6).
+"""What libfraccontact refuses up front (time series and steps beyond its
+limits; a full G1 history that would outgrow its limit, also in the FMU and
+the solver), how a long run is stopped (its progress callback), and what the
+springpot's rows cost.
 
 Calls that the code before these fixes ran for hours or until the kernel
 killed them run here in a child process with a memory limit and a timeout,
@@ -16,8 +17,11 @@ import textwrap
 import time
 
 import pytest
+from fmpy.fmi1 import FMICallException
 
+import fraccontact
 from fraccontact import _lib
+from test_solver import solve_limited
 
 LIB = _lib.LIB
 FC_OK, FC_EINVAL, FC_ENOMEM, FC_ESTOPPED = 0, 1, 3, 4
@@ -83,7 +87,7 @@ def fc_run_in_child(interval, seconds=60, **values):
     return in_child(RUN_IN_CHILD.format(values=values, interval=interval), seconds)
 
 
-# ---------------------------------------------------------------- item 1: rows beyond what a run keeps
+# ---------------------------------------------------------------- rows beyond what a run keeps
 
 
 @pytest.mark.parametrize("values, interval, rows", [
@@ -141,7 +145,7 @@ def test_simulate_refuses_an_output_interval_beyond_the_limit():
     assert r.startswith("output_interval = 1e-12 is invalid: the time series would hold at least"), r
 
 
-# ---------------------------------------------------------------- item 4: steps beyond the limit
+# ---------------------------------------------------------------- steps beyond the limit
 
 
 @pytest.mark.parametrize("values, steps", [
@@ -184,7 +188,7 @@ def test_impact_refuses_a_run_of_more_than_a_billion_steps():
     assert r.startswith("dt_max = 1e-13 is invalid: the run would take at least 1.23e+10 internal steps"), r
 
 
-# ---------------------------------------------------------------- item 4: progress and stop
+# ---------------------------------------------------------------- progress and stop
 
 
 CASES = {   # each runs for seconds to minutes, and must stop within STOP_WITHIN of being asked
@@ -310,7 +314,7 @@ def test_a_stopped_run_leaks_nothing():
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 50_000  # kB
 
 
-# ---------------------------------------------------------------- item 6: the springpot's rows
+# ---------------------------------------------------------------- the springpot's rows
 
 
 def rows_and_impacts(interval, **values):
@@ -376,3 +380,56 @@ def test_a_row_at_a_separation_is_the_impacts_figures():
         # x2_end is x2 there less its rate over that rounding; eps = -v / v_onset, two roundings
         assert row[4] == pytest.approx(i.x2_end, rel=1e-15, abs=0)
         assert row[5] == pytest.approx(-i.eps * i.v_onset, rel=1e-15, abs=0)
+
+
+# ------------------------------------ memory = 1: the full history past its limit
+
+def quickly(code, seconds):
+    """Runs Python `code` in a fresh process with this one's environment:
+    (finished within `seconds`, its stderr)."""
+    try:
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=seconds)
+    except subprocess.TimeoutExpired:
+        return False, "still running after %g s" % seconds
+    return True, done.stderr
+
+
+def test_the_fmu_refuses_a_full_history_past_its_limit_at_initialization(slave):
+    """`fmpy simulate ... damper 2 memory 1 --stop-time 0.2` ran 19 minutes
+    and then failed: 0.2 s is 2e6 steps of 1e-7 s, the history holds
+    1 048 576 (0.1048576 s). The stop time is known at setupExperiment, so
+    exitInitializationMode refuses, naming memory, the stop time and the
+    rule; 0.1 s, within the limit, starts."""
+    s = slave(start=False, damper=2, memory=1)
+    s.fmu.setupExperiment(startTime=0.0, stopTime=0.2)
+    s.fmu.enterInitializationMode()
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    message = s.last_error()
+    assert "memory = 1" in message and "stopTime" in message and "0.2" in message and "1048576" in message
+    ok = slave(start=False, damper=2, memory=1)
+    ok.fmu.setupExperiment(startTime=0.0, stopTime=0.1)
+    ok.start()
+
+
+def test_the_library_refuses_a_full_history_that_may_outgrow_its_limit():
+    """With gravity the striker bounces on until t_end (1 s: 1e7 steps), so
+    the library refuses at once instead of failing at 1 048 576 steps after
+    minutes of O(N^2) work; one impact without gravity (the run ends at the
+    separation) still runs."""
+    code = ("import fraccontact\n"
+            "try:\n"
+            "    fraccontact.impact(damper=2, memory=1, g=9.81, impacts=3)\n"
+            "except ValueError as e:\n"
+            "    raise SystemExit(str(e))\n")
+    finished, stderr = quickly(code, 30)
+    assert finished, stderr
+    assert "memory = 1" in stderr and "t_end = 1" in stderr and "1048576" in stderr
+    r = fraccontact.impact(damper=2, memory=1)
+    assert r.stopped == "impacts" and r.impacts == 1
+
+
+def test_the_solver_refuses_a_full_history_that_may_outgrow_its_limit():
+    done = solve_limited("--damper", 2, "--memory", 1, "--g", 9.81, "--impacts", 3, seconds=30)
+    assert done.returncode == 2 and "memory = 1" in done.stderr and "t_end" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1

@@ -1,9 +1,14 @@
 """The fraccontact package in-process: impact, impacts, simulate, parameters,
 fmu_path, against independent truths (scipy's solve of the same ODE,
 closed forms, identities) and against each other (a batch is the same runs
-one by one)."""
+one by one); the files `pip install .` puts in the package, where the
+package finds them, and docs/python.md's account of them, its commands and
+the scenes' API."""
 
 import math
+import pathlib
+import re
+import tomllib
 
 import numpy as np
 import pytest
@@ -12,7 +17,13 @@ from fraccontact.scipy_contact import solve_drop
 
 import fraccontact
 from closed_forms import HERTZ_TC, SCHEME_RTOL, hertz_k
+from doc_pages import section, text
 from fmu_driver import C, K, M, V0
+from fraccontact import cli, crash, ssp
+from fraccontact.scenes import bumper, headform, masters
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 
 
 def test_impact_is_the_drop_test_of_scipy():
@@ -143,3 +154,75 @@ def test_fmu_path_is_an_fmu(fmu_path):
 def test_warning_names_a_material_without_effect():
     assert "E_s = 1.2e+09 has no effect" in fraccontact.warning(E_s=1.2e9)
     assert fraccontact.warning() is None and fraccontact.warning(k=0, E_s=1.2e9) is None
+
+
+# ------------------------------------------------ what the package ships, and docs/python.md
+
+def test_the_package_ships_the_scene_its_reports_run():
+    """pip install . builds with FRACCONTACT_PACKAGE: the SSPs (the drop
+    test, the crash scenes) are made and installed into the package beside
+    the FMUs, where ssp_path() and scenes.masters.ssp_path() look (scripts/test
+    installs the package and runs the scenes)."""
+    cmake = (ROOT / "CMakeLists.txt").read_text()
+    package = re.search(r"if\(FRACCONTACT_PACKAGE\)\n(.*?)\n  return\(\)", cmake, re.S).group(1)
+    assert "add_subdirectory(ssp)" in package and "include(ssp/scenes.cmake)" in package
+    installed = re.search(r'install\(FILES (.*?) DESTINATION fraccontact\)', package, re.S).group(1)
+    for name in ("${SSP_FILE}", "${FMU_FILE}", "body.fmu", "${SCENE_SSP_FILES}"):
+        assert name in installed, name
+    ssp_cmake = (ROOT / "ssp" / "CMakeLists.txt").read_text()
+    assert 'set(SSP_FILE "${CMAKE_BINARY_DIR}/drop_test.ssp" PARENT_SCOPE)' in ssp_cmake
+    scenes_cmake = (ROOT / "ssp" / "scenes.cmake").read_text()
+    assert "foreach(scene headform bumper)" in scenes_cmake
+    assert 'list(APPEND SCENE_SSP_FILES "${ssp_file}")' in scenes_cmake
+    assert PYPROJECT["tool"]["scikit-build"]["wheel"]["packages"] == ["python/fraccontact"]
+
+
+def test_the_scene_is_found_beside_the_installed_fmus(monkeypatch, tmp_path):
+    """An installed package: no environment variables, the FMUs and the scene in the package's folder."""
+    for name in ("fraccontact.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"):
+        (tmp_path / name).write_bytes(b"")
+    monkeypatch.setattr(fraccontact, "_HERE", tmp_path)
+    for variable in ("FRACCONTACT_FMU", "DROP_TEST_SSP"):
+        monkeypatch.delenv(variable, raising=False)
+    assert ssp.ssp_path() == tmp_path / "drop_test.ssp"
+    for scene in ("headform", "bumper"):
+        assert masters.ssp_path(scene) == tmp_path / f"{scene}.ssp"
+
+
+def installed_files():
+    """The names of the files `pip install .` puts in the package beside its
+    library: CMakeLists.txt's install(FILES ...) of the package build, the
+    scenes' SSPs from ssp/scenes.cmake's loop."""
+    cmake = (ROOT / "CMakeLists.txt").read_text()
+    listed = re.search(r"install\(FILES (.*?) DESTINATION fraccontact\)", cmake, re.S).group(1)
+    names = set(re.findall(r"/([\w.]+\.(?:fmu|ssp))\"", listed))
+    variables = {"${FMU_FILE}": re.search(r'set\(FMU_FILE "\$\{CMAKE_BINARY_DIR\}/([\w.]+)"\)', cmake).group(1),
+                 "${SSP_FILE}": re.search(r'set\(SSP_FILE "\$\{CMAKE_BINARY_DIR\}/([\w.]+)"',
+                                          (ROOT / "ssp" / "CMakeLists.txt").read_text()).group(1)}
+    names |= {name for variable, name in variables.items() if variable in listed}
+    assert "${SCENE_SSP_FILES}" in listed
+    scenes = re.search(r"foreach\(scene ([\w ]+)\)", (ROOT / "ssp" / "scenes.cmake").read_text()).group(1).split()
+    return names | {f"{scene}.ssp" for scene in scenes}
+
+
+def test_the_package_page_names_every_file_the_package_ships():
+    shipped = installed_files()
+    assert {"fraccontact.fmu", "striker.fmu", "body.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"} <= shipped
+    prose = " ".join(section("In Python: the `fraccontact` package").split())
+    assert [name for name in sorted(shipped) if f"`{name}`" not in prose] == []
+
+
+def test_the_package_page_names_every_command():
+    prose = " ".join(text("docs/python.md").split())
+    assert [c for c in cli.COMMANDS if f"`fraccontact {c}" not in prose and f"`{c}`" not in prose] == []
+    assert "`fraccontact scene NAME`" in prose
+
+
+def test_the_scene_api_the_page_names_exists():
+    """Every `module.name(` the scenes' section calls is a function of that
+    module of the package."""
+    body = section("The crash scenes and their figures in Python")
+    called = set(re.findall(r"`(masters|headform|bumper|crash)\.(\w+)\(", body))
+    assert {("masters", "run"), ("masters", "figures"), ("crash", "figures")} <= called
+    modules = {"masters": masters, "headform": headform, "bumper": bumper, "crash": crash}
+    assert [f"{m}.{f}" for m, f in sorted(called) if not callable(getattr(modules[m], f, None))] == []

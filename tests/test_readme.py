@@ -41,7 +41,7 @@ def fmpy_commands():
     return commands
 
 
-# --- issue 10, item 13: fmpy simulate must write something ------------------
+# --- fmpy simulate must write something --------------------------------------
 
 COMMANDS = fmpy_commands()
 
@@ -79,7 +79,7 @@ def test_fmpy_simulate_command_writes_the_outputs(command, tmp_path):
     assert result["F"].max() == pytest.approx(expected, rel=0.05, abs=0)  # sampled, so below the peak
 
 
-# --- issue 10, item 14: the master loop and its signs -----------------------
+# --- the master loop and its signs -------------------------------------------
 
 def master_loop_block():
     """The Python block of 'Use it in a co-simulation' (docs/coupling.md)."""
@@ -131,7 +131,7 @@ def test_the_readme_master_loop_is_the_drop_test(g):
         assert truth["eps"] == pytest.approx(0.5861, rel=0, abs=1e-4)  # README, "Two commands"
 
 
-# --- issue 10, item 7: the variable table -----------------------------------
+# --- the variable table ------------------------------------------------------
 # (its value references, causalities, units and defaults: test_parameter_table.py)
 
 def variable_table():
@@ -187,7 +187,7 @@ def test_k_wins_over_the_materials_as_the_table_says():
     assert math.isfinite(derived)
 
 
-# --- issue 13: the FMI 3.0 example --------------------------------------------
+# --- the FMI 3.0 example -----------------------------------------------------
 
 def test_the_readme_fmi3_example_returns_where_it_says():
     """The Python block of 'FMI 2.0 or FMI 3.0', run as written: its comment
@@ -206,7 +206,7 @@ def test_the_readme_fmi3_example_returns_where_it_says():
         assert np.count_nonzero(np.abs(off_grid - when) < 5e-11) == 2, (when, off_grid)
 
 
-# --- issue 23, item 25: every Python block runs quietly, as written ----------
+# --- every Python block runs quietly, as written -----------------------------
 
 BUILT = {"build/fraccontact.fmu": CONTACT, "build/fraccontact-fmi3.fmu": CONTACT.parent / "fraccontact-fmi3.fmu",
          "build/striker.fmu": pathlib.Path(os.environ.get("STRIKER_FMU", CONTACT.parent / "striker.fmu")),

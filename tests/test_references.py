@@ -1,11 +1,11 @@
-"""Every reference in the repository points inside it (issue 24, items 3
-and 6): a path a comment, a docstring, a --help text or a page names
-(docs/x.md, scripts/x, python/..., tests/..., solver/..., fmu_src/...,
-a .py file given with its directory) is a file or folder the repository
-has; a "docs/model.md §n" is one of the sections docs/model.md has; and
-nothing refers to the specification given beside the clone (its folder
-or its two files, by the names OUTSIDE below matches). A file renamed or split without its references
-fails here with the file:line that still names it."""
+"""Every reference in the repository points inside it: a path a comment, a
+docstring, a --help text or a page names (docs/x.md, scripts/x, python/...,
+tests/..., solver/..., fmu_src/..., a .py file given with its directory) is
+a file or folder the repository has; a "docs/model.md §n" is one of the
+sections docs/model.md has; and nothing refers to the specification given
+beside the clone (its folder or its two files, by the names OUTSIDE below
+matches). A file renamed or split without its references fails here with
+the file:line that still names it."""
 
 import fnmatch
 import pathlib

@@ -1,4 +1,4 @@
-"""The crash scenes as co-simulations (issue 25): the body FMU against the
+"""The crash scenes as co-simulations: the body FMU against the
 exact solution of its linear ODE, the scenes' SSPs in fmpy, libcosim and a
 container FMU against their monolithic reference (scenes.chain, scipy) and
 each other, their energy and momentum balances, the SSV files against the
@@ -255,7 +255,7 @@ def test_scene_command_prints_the_reference_figures(references):
     (["headform", "--master", "simulink"], "argument --master: invalid choice: 'simulink'"),
     (["crash"], "argument NAME: invalid choice: 'crash'"),
     (["headform", "--t-end", "1", "--H", "1e-7"], "steps: at most 2e+06"),
-    # issue 35, items 12 and 13: what cannot give a figure is refused before the run; a negative
+    # What cannot give a figure is refused before the run; a negative
     # number in any notation is the option's value.
     (["headform", "--t-end", "1e-5"], "--t-end 1e-05 is invalid: at least 3 steps of --H 1e-05 s"),
     (["headform", "--t-end", "2e-5", "--master", "libcosim"], "--t-end 2e-05 is invalid: at least 3 steps"),
@@ -270,7 +270,7 @@ def test_scene_command_refuses_bad_input_on_one_line(args, message):
     assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
 
 
-# --- issue 35 ----------------------------------------------------------------
+# --- short, cut and fine runs, Ctrl-C, damaged SSPs, the pages' blocks -------
 
 def test_the_fewest_steps_accepted_give_figures():
     """Three steps (the refusals above: fewer) give every figure but those
@@ -283,7 +283,7 @@ def test_the_fewest_steps_accepted_give_figures():
 
 @pytest.mark.parametrize("scene, t_end, contact", [("headform", "0.012", "skin"), ("bumper", "0.01", "fascia")])
 def test_an_impact_cut_short_has_no_duration_nor_restitution(scene, t_end, contact, references):
-    """Item 3: cut short, the contact is still on: duration and restitution
+    """Cut short, the contact is still on: duration and restitution
     are null, a warning names the contact and t_end, and the head's HIC15 is
     marked as a lower bound (below the whole impact's)."""
     r = scene_command(scene, "--master", "reference", "--t-end", t_end)
@@ -299,7 +299,7 @@ def test_an_impact_cut_short_has_no_duration_nor_restitution(scene, t_end, conta
 
 
 def test_a_fine_step_gives_its_figures_in_bounded_time(references):
-    """Item 8: H = 1e-7 s did not finish in 580 s (crashmetrics' HIC search
+    """H = 1e-7 s did not finish in 580 s (crashmetrics' HIC search
     on 350 000 samples); now its HIC15 is searched on the 1e-5 s grid and
     agrees with H = 1e-5 s's to the record's own discretization (2.6e-5
     between the two seen, docs/scenes.md: the grid's error at finer H)."""
@@ -313,7 +313,7 @@ def test_a_fine_step_gives_its_figures_in_bounded_time(references):
     m == "omsimulator" and not omsimulator.available(), reason="OMSimulator is not installed (docs/ssp.md)"))
     for m in masters.MASTERS])
 def test_ctrl_c_stops_a_scene_on_one_line(master):
-    """Item 13: SIGINT mid-run (a run of 1 s of simulated time, far longer
+    """SIGINT mid-run (a run of 1 s of simulated time, far longer
     than the wait): one line, exit status 130, nothing on stdout. (SIGINT's
     default restored in the child: a shell's background job ignores it.)"""
     p = subprocess.Popen([sys.executable, "-m", "fraccontact", "scene", "headform", "--master", master, "--t-end", "1"],
@@ -326,7 +326,7 @@ def test_ctrl_c_stops_a_scene_on_one_line(master):
 
 
 def test_a_missing_or_damaged_ssp_is_one_line(tmp_path):
-    """Item 13: the SSPs are looked for beside $FRACCONTACT_FMU."""
+    """The SSPs are looked for beside $FRACCONTACT_FMU."""
     missing = subprocess.run([sys.executable, "-m", "fraccontact", "scene", "headform"], capture_output=True,
                              text=True, env=dict(os.environ, FRACCONTACT_FMU="/nonexistent/x.fmu"), timeout=300)
     shutil.copy(fmu_path(), tmp_path / "fraccontact.fmu")
@@ -342,7 +342,7 @@ def test_a_missing_or_damaged_ssp_is_one_line(tmp_path):
 
 @pytest.mark.parametrize("master", ["container", "container-gs"])
 def test_the_container_masters_run_quietly(master):
-    """Item 15: the container's log on every run (its version, its mode and
+    """The container's log on every run (its version, its mode and
     a "Solver configure...." sent with status Error) is kept for a run that
     fails: a run that succeeds prints its figures and nothing else."""
     r = scene_command("headform", "--master", master)
@@ -351,7 +351,7 @@ def test_the_container_masters_run_quietly(master):
 
 
 def test_the_pages_fmpy_blocks_run_the_scenes_bindings(references):
-    """Item 19: fmpy's simulate_ssp applies no SSV binding: the pages'
+    """fmpy's simulate_ssp applies no SSV binding: the pages'
     blocks pass fraccontact.ssp.bound_parameters, and print the reference's
     figures to the co-simulation's error (TOLERANCES) and the digits their
     comments quote."""
@@ -374,7 +374,7 @@ CLEARANCE_ROW = re.compile(r"\| clearance for HIC15 = (\d+), (adult|child) \(lib
 
 
 def test_quoted_clearances_are_where_hic15_crosses_its_limit():
-    """Item 4: docs/scenes.md quotes each clearance to 0.01 mm: a hundredth
+    """docs/scenes.md quotes each clearance to 0.01 mm: a hundredth
     of a millimetre closer HIC15 is above the limit, one further below it,
     in the master quoted (the report's root finder, to 1e-7 m)."""
     rows = CLEARANCE_ROW.findall((pathlib.Path(__file__).parent.parent / "docs" / "scenes.md").read_text())

@@ -16,8 +16,11 @@ import time
 
 import pytest
 
+import fraccontact
+from closed_forms import EPS
 from fmu_driver import C, K, M, run_impact
 from fraccontact.scipy_contact import solve_drop
+from test_fmu_features import reference
 from test_fmu_physics import reference_drop
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -170,7 +173,7 @@ def test_extrapolated_g1_law_is_second_order():
         assert all(abs(p - 2) < 0.15 for p in observed), (key, errors, observed)
 
 
-# ---------------------------------------------------------------- issue 10: the CLI as a user meets it
+# ---------------------------------------------------------------- the CLI as a user meets it
 
 def without_timing(r):
     return {key: value for key, value in r.items() if key != "cpu_seconds"}
@@ -354,7 +357,34 @@ def test_an_underflowing_indentation_is_no_separation(method):
     assert r["impacts"] == 0 and r["end"]["eps"] == 0 and r["stopped"] == "t_end" and r["end"]["v"] == 5e-324
 
 
-# ---------------------------------------------------------------- issue 23: limits, Ctrl-C, rows' cost, options
+# ---------------------------------------------------------------- an overdamped contact at rest
+
+def test_an_overdamped_contact_rests_instead_of_ending_at_a_denormal_eps():
+    """A linear spring k = 3.3e8 N/m in series with c = 6080 N s/m under
+    0.74 kg is overdamped ((k/c)^2 > 4 k/m): force and speed decay
+    together, and x1 never falls through 0 on the way out. It 'ended' at
+    73 ms with eps 5.5e-317 when x1 underflowed; now the run says it rests:
+    no impact finished, the force and the speed below rounding of their
+    peak and onset values, the momentum all in the dent (m v0 = c x2)."""
+    r = fraccontact.impact(spring_exponent=1.0)
+    assert r.stopped == "resting" and r.impacts == 0 and math.isnan(r.eps) and r.end.eps == 0.0
+    assert abs(r.end.v) <= EPS * V0
+    assert r.end.x2 == pytest.approx(M * V0 / 6080.0, rel=1e-12, abs=0)  # rounding over ~37 000 steps
+    for mode in ((), ("--reference",)):
+        out = solve_json("--spring-exponent", 1, *mode)
+        assert out["stopped"] == "resting" and out["eps"] is None and out["impacts"] == 0, mode
+
+
+def test_a_small_true_rebound_still_ends_its_impact():
+    """The Hertz law with c = 100 rebounds at eps 2.4e-7 after 0.108 s
+    (GSL agrees): a real separation, not a rest."""
+    r = fraccontact.impact(c=100.0, law="hertz")
+    ref = reference("--c", 100)
+    assert r.stopped == "impacts" and r.eps == pytest.approx(ref["eps"], rel=1e-4, abs=0)
+
+
+
+# ---------------------------------------------------------------- limits, Ctrl-C, rows' cost, options
 
 def solve_limited(*args, seconds=30, cwd=None):
     """The solver with at most 2 GB of address space and `seconds` of time:
@@ -379,7 +409,7 @@ def refused(done, option):
 
 
 def test_rows_beyond_what_a_run_keeps_are_refused_up_front(tmp_path):
-    """Item 1: a row every picosecond over h20's contact is 1.2e9 rows."""
+    """A row every picosecond over h20's contact is 1.2e9 rows."""
     out = tmp_path / "rows.csv"
     done = solve_limited("--csv", out, "--output-interval", "1e-12")
     why = refused(done, "--output-interval '1e-12': output_interval = 1e-12 is invalid: ")
@@ -393,7 +423,7 @@ def test_an_output_interval_without_csv_is_refused():
 
 @pytest.mark.parametrize("args", [["--dt-max", "1e-15"], ["--dt-max", "1e-13", "--law", "hertz"]])
 def test_a_run_beyond_a_billion_steps_is_refused_up_front(args):
-    """Item 4: --dt-max 1e-15 ran for hours printing nothing."""
+    """--dt-max 1e-15 ran for hours printing nothing."""
     why = refused(solve_limited(*args), f"--dt-max '{args[1]}': dt_max = {float(args[1]):g} is invalid: ")
     assert "more than 1e+09" in why and "internal steps" in why
 
@@ -402,7 +432,7 @@ LONG_RUN = ["--dt-max", "1e-11"]   # 1.2e8 steps: about ten seconds
 
 
 def test_ctrl_c_stops_a_solve_with_one_line_and_status_130(tmp_path):
-    """Item 4: SIGINT stops the solve within a fraction of a second; nothing
+    """SIGINT stops the solve within a fraction of a second; nothing
     is written; one line says why (no progress line off a terminal)."""
     out = tmp_path / "series.csv"
     p = subprocess.Popen([SOLVE, *LONG_RUN, "--csv", str(out), "--output-interval", "1e-6"], stdout=subprocess.PIPE,
@@ -452,7 +482,7 @@ def test_a_long_solve_shows_its_progress_on_a_terminal_and_ctrl_c_stops_it():
 
 
 def test_the_springpots_csv_costs_about_what_its_solve_costs(tmp_path):
-    """Item 6: the issue's run with --csv took 12.3 s of CPU against 0.014 s
+    """The run with --csv took 12.3 s of CPU against 0.014 s
     without; rows may cost about what steps cost. The ratio measured is in
     the report; 10 is a guard with room for a loaded machine."""
     args = ["--damper", "2", "--g", "9.81", "--impacts", "3", "--json"]
@@ -477,7 +507,7 @@ def test_the_springpots_csv_costs_about_what_its_solve_costs(tmp_path):
     (["--reference", "--damper", "2"], "--damper '2': --reference integrates the dashpot (damper 1) only"),
     (["--rtol", "1e-9"], "--rtol '1e-9': the relative tolerance of --reference, which is not given")])
 def test_options_the_solve_would_ignore_or_misread_are_refused(args, says):
-    """Item 22: one line naming the option, its value and the rule; exit 2."""
+    """One line naming the option, its value and the rule; exit 2."""
     refused(solve(*args, check=False), says)
 
 

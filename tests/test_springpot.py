@@ -1,4 +1,4 @@
-"""The springpot damper F = c_alpha D^alpha x2 (issue 12, docs/model.md §5-§6) and
+"""The springpot damper F = c_alpha D^alpha x2 (docs/model.md §5-§6) and
 the general spring exponent n, against what is known independently of the C
 code: closed forms (the power rule, the fractional Maxwell model's
 Mittag-Leffler function computed here with mpmath, the elastic contact time

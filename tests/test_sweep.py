@@ -108,7 +108,7 @@ def test_help_states_the_default_law_and_the_scatter():
 
 
 def test_any_parameter_by_either_name(tmp_path):
-    """Issue 10, item 12: t-end, law and impacts were refused; the library's
+    """t-end, law and impacts were once refused; the library's
     names (E_s, t_end) and the command line's spelling (E-s, t-end) alike;
     the columns carry the library's names."""
     assert sweep.main(["--vary", "law=hertz,g1x", "--vary", "impacts=1,3", "--vary", "t-end=0.05,0.3",
@@ -164,7 +164,7 @@ def monte_carlo(tmp_path_factory):
 
 @pytest.mark.parametrize("name, nominal", [("k", K), ("c", C)])
 def test_scatter_is_log_normal_with_the_stated_mean_and_cv(monte_carlo, name, nominal):
-    """Issue 10, item 11. A log-normal variable with mean M and coefficient
+    """A log-normal variable with mean M and coefficient
     of variation s has ln X ~ Normal(ln M - S^2/2, S^2), S^2 = ln(1 + s^2).
     The sample mean of ln X has standard error S/sqrt(N) and the sample
     standard deviation about S/sqrt(2(N-1)); 4 standard errors pass a

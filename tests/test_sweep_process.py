@@ -1,4 +1,4 @@
-"""The sweep and the process that runs it (issue 35, items 11 and 14): a
+"""The sweep and the process that runs it: a
 program that calls sweep.main keeps its malloc settings, its SIGTERM
 handler and its log, and the local workers close without an error in the
 log. Each runs in a process of its own: malloc's settings are the

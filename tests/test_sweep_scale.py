@@ -1,4 +1,4 @@
-"""Issue 26: the columnar sweep. Each task computes its own cases (a slice of
+"""The columnar sweep. Each task computes its own cases (a slice of
 the grid, or its draws from the seed) and writes them, inputs beside
 results, as a Parquet partition; case i is the same whatever the tasks and
 the workers, so the partitions are the same bytes on 1 or 2 workers, on a
@@ -513,7 +513,7 @@ def test_a_worker_killed_mid_run_loses_nothing(cluster, tmp_path):
 
 
 def test_the_benchmarks_quote_the_scaling_report():
-    """docs/benchmarks.md's section of issue 26's targets gives the figures
+    """docs/benchmarks.md's section on the sweep at scale gives the figures
     docs/sweep_scaling.md measured (scripts/report sweep_scaling writes
     both), and every run there gave the same bytes."""
     root = os.path.join(os.path.dirname(__file__), "..")
@@ -535,7 +535,7 @@ def test_the_benchmarks_quote_the_scaling_report():
 
 @pytest.mark.parametrize("signum, status, said", [
     (signal.SIGINT, 130, "interrupted; nothing written"),
-    (signal.SIGTERM, 143, "terminated (SIGTERM); nothing written"),  # issue 35 item 14: 26f430c left the hidden folder
+    (signal.SIGTERM, 143, "terminated (SIGTERM); nothing written"),  # 26f430c left the hidden folder
 ], ids=["ctrl-c", "sigterm"])
 def test_a_signal_stops_the_sweep_and_leaves_nothing(signum, status, said, tmp_path):
     """SIGINT (Ctrl-C) or SIGTERM (timeout, batch systems) while the tasks

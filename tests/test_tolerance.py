@@ -2,17 +2,24 @@
 (the dashpot) and Radau IIA (the springpot) against scipy's solution of the same ODE (independent of the C code), the
 momentum and energy identities, the FMU at a communication step, bad values,
 and the laws and scenes it applies to; the springpot's compressed memory
-against its full G1 history."""
+against its full G1 history; tolerance alone choosing the steps (dt_max = 0
+caps nothing) against GSL's reference and docs/numerics.md's table."""
 
 import math
+import pathlib
 import re
+import time
 
 import numpy as np
 import pytest
 
 import fraccontact
 from fmu_driver import C, K, M, V0, run_impact
+from test_fmu_features import reference as gsl_reference
 from test_fmu_physics import reference_drop
+from test_solver import solve_json
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 FIGURES = ("F_peak", "eps", "t_contact", "x2_end")
 
@@ -329,3 +336,65 @@ def test_springpot_fmu_at_a_communication_step_of_1e_5(slave, springpot_referenc
     x2 = [fraccontact.impact(memory=1, dt_max=dt, t_end=s.t, impacts=2, **SPRINGPOT).end.x2
           for dt in (6.25e-8, 3.125e-8)]
     assert r["x2"] == pytest.approx(x2[1] + (x2[1] - x2[0]) / 3, rel=1e-6, abs=0)
+
+
+# ---------------------------------------------- tolerance on its own: dt_max = 0 caps nothing
+
+def test_tolerance_alone_chooses_the_steps():
+    """`fraccontact-solve --law hertz --height 0.02 --tolerance 1e-6` took
+    the 13 161 steps of 1e-7 s: dt_max = 1e-7 capped the error-controlled
+    steps. dt_max = 0, the default, caps nothing now: a few dozen steps,
+    the figures within 15 times the tolerance of GSL's (docs/numerics.md, "Error-
+    controlled steps")."""
+    r = solve_json("--law", "hertz", "--height", 0.02, "--tolerance", 1e-6)
+    ref = gsl_reference("--height", 0.02)
+    assert r["steps"] < 30 and r["method"] == "esdirk54"
+    for key in ("F_peak", "eps", "t_contact", "x2_end"):
+        assert r[key] == pytest.approx(ref[key], rel=15e-6, abs=0), key
+    assert fraccontact.impact(law="hertz", tolerance=1e-6).steps == r["steps"]
+
+
+def test_dt_max_zero_is_the_fixed_step_of_1e_7_to_the_bit():
+    """The default dt_max = 0 takes fixed steps of 1e-7 s: every figure the
+    same as dt_max = 1e-7 given, to the last bit."""
+    assert fraccontact.defaults()["dt_max"] == 0.0
+    for law in ("g1", "hertz", "g1x"):
+        default, given = fraccontact.impact(law=law, dt_max=0.0), fraccontact.impact(law=law, dt_max=1e-7)
+        assert default == given, law
+    assert fraccontact.impact(damper=2, dt_max=0.0) == fraccontact.impact(damper=2, dt_max=1e-7)
+
+
+def test_tolerance_alone_makes_the_fmu_fast(slave):
+    """The FMU at tolerance 1e-6, nothing else set: the h20 impact in one
+    communication step of 10 ms costs far less than with fixed steps (it
+    took 13 161 steps either way: ESDIRK steps capped at 1e-7 s cost more)."""
+    def seconds(**values):
+        best = math.inf
+        for _ in range(5):
+            s = slave(law=2, **values)
+            t0 = time.process_time()
+            s.step(1e-2)
+            best = min(best, time.process_time() - t0)
+            assert s.get("eps") > 0.5
+        return best
+    assert seconds(tolerance=1e-6) < seconds() / 10
+
+
+NUMERICS = (ROOT / "docs" / "numerics.md").read_text()
+
+
+def test_the_readme_tolerance_table_is_what_tolerance_alone_gives():
+    """docs/numerics.md's table of internal steps and largest error against GSL
+    for the h20 impact at each tolerance, remeasured: steps exactly, the
+    error to the two digits shown."""
+    lines = NUMERICS.splitlines()
+    top = next(i for i, line in enumerate(lines) if line.startswith("| `tolerance` | 1e-6 |"))
+    tolerances, steps, errors = ([c.strip() for c in line.strip("|").split("|")[1:]]
+                                 for line in (lines[top], lines[top + 2], lines[top + 3]))
+    assert lines[top + 2].startswith("| internal steps |") and lines[top + 3].startswith("| largest error")
+    ref = gsl_reference("--height", 0.02)
+    for tolerance, n, error in zip(tolerances, steps, errors):
+        r = solve_json("--law", "hertz", "--height", 0.02, "--tolerance", tolerance)
+        worst = max(abs(r[key] / ref[key] - 1) for key in ("F_peak", "eps", "t_contact", "x2_end"))
+        assert r["steps"] == int(n), tolerance
+        assert float(f"{worst:.1e}") == float(error), (tolerance, worst)

@@ -1,20 +1,28 @@
-"""Issue 25, items 1 and 2: the contact between two moving bodies (inputs v2,
-m2: the approach speed v - v2 and the reduced mass m m2/(m + m2); -F on the
-striker, +F on the second body) and the forces the proxy striker cannot see
-(inputs a, a2: the other forces' accelerations at each step's start), in
-FMI 2.0 and 3.0, under Gauss-Seidel and Jacobi masters. docs/two_bodies.md."""
+"""The contact between two moving bodies (inputs v2, m2: the approach speed
+v - v2 and the reduced mass m m2/(m + m2); -F on the striker, +F on the
+second body) and the forces the proxy striker cannot see (inputs a, a2: the
+other forces' accelerations at each step's start), in FMI 2.0 and 3.0, under
+Gauss-Seidel and Jacobi masters, and in one call of the library and the
+solver (its reference too); a, a2 and coupling refused there with the
+reason. docs/two_bodies.md."""
 
+import json
 import math
 import os
 import pathlib
 import shutil
+import subprocess
 
 import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 
+import fraccontact
+from closed_forms import HERTZ_TC, SCHEME_RTOL
+from doc_pages import section
 from fraccontact.cosim import (M, V0, Unit, cosimulate, energy_error, monolithic, other_acceleration, spring_reference,
                                striker_values)
+from test_solver import SOLVE
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
@@ -391,3 +399,69 @@ def test_an_approach_speed_beyond_double_is_refused(slave):
         s.set(v2=-1e308)
     assert "v2 = -1e+308 is invalid: the approach speed v - v2 must be finite" in s.last_error()
     assert s.get("v2") == 0.0
+
+
+# ------------------------------------------------ two bodies in one call of the library and the solver
+
+K, MR = 3.299e8, M1 * M2 / (M1 + M2)
+
+
+def test_the_two_body_impact_is_one_call_and_the_elastic_closed_form():
+    """4.5 kg at 3 m/s on a 2 kg body at 1 m/s, no damping to speak of
+    (c = 1e300): Hertz's closed form (docs/model.md §2) at the approach speed
+    2 m/s with the reduced mass 18/13 kg. Tolerances: the scheme's
+    (closed_forms.SCHEME_RTOL, 3x what it measures; here F_peak 1.0e-9,
+    t_contact 3.2e-9, eps 1.6e-11)."""
+    r = fraccontact.impact(law="hertz", c=1e300, v=3.0, m=M1, v2=1.0, m2=M2)
+    u = 3.0 - 1.0
+    x_max = (5 * MR * u * u / (4 * K)) ** 0.4
+    assert r.F_peak == pytest.approx(K * x_max ** 1.5, rel=SCHEME_RTOL["F_peak"], abs=0)
+    assert r.t_contact == pytest.approx(HERTZ_TC * x_max / u, rel=SCHEME_RTOL["t_contact"], abs=0)
+    assert r.eps == pytest.approx(1.0, rel=SCHEME_RTOL["eps"], abs=0)
+    assert r.v_onset == u
+
+
+def test_the_solvers_reference_takes_the_two_bodies_too():
+    """--reference (GSL at --rtol 1e-12) with --v2 and --m2: the same closed
+    form, within 1e-10 (100x the reference's tolerance; it measures 1e-14)."""
+    done = subprocess.run([SOLVE, "--reference", "--law", "hertz", "--c", "1e300", "--v", "3", "--m", str(M1),
+                           "--v2", "1", "--m2", str(M2), "--json"], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    r = json.loads(done.stdout)
+    x_max = (5 * MR * 2.0 ** 2 / (4 * K)) ** 0.4
+    assert r["F_peak"] == pytest.approx(K * x_max ** 1.5, rel=1e-10, abs=0)
+    assert r["t_contact"] == pytest.approx(HERTZ_TC * x_max / 2.0, rel=1e-10, abs=0)
+    assert r["end"]["v"] == pytest.approx(-2.0, rel=1e-10, abs=0)  # the approach speed, reversed
+
+
+def test_the_two_body_impact_is_the_two_free_bodies_co_simulation():
+    """Against the two bodies each integrated by the master and exchanging
+    -F and +F (two_bodies() above): their F_peak, and eps from the
+    bodies' own final velocities, to the rounding of the same internal
+    steps taken in another order (ROUNDING there, 1e-12)."""
+    r = fraccontact.impact(law="hertz", v=V, m=M1, v2=0.0, m2=M2)
+    bodies = two_bodies(2, 1, 1e-5)
+    assert r.F_peak == pytest.approx(bodies["F_peak"], rel=1e-12, abs=0)
+    assert r.eps == pytest.approx(bodies["eps"], rel=1e-12, abs=0)
+
+
+def test_the_second_bodys_values_are_refused_by_name():
+    for params, says in ((dict(m2=-1.0), "m2 = -1 is invalid: the second body's mass"),
+                         (dict(v2=math.inf), "v2 = inf is invalid: the second body's velocity must be finite"),
+                         (dict(v=1.5e154, m=1.0, v2=-1.5e154, m2=1.0), "the relative motion of the two bodies")):
+        with pytest.raises(ValueError, match="^" + says.replace("(", r"\(")):
+            fraccontact.impact(**params)
+        option = "--" + next(iter(params))
+        done = subprocess.run([SOLVE, *(str(x) for k, v in params.items() for x in (f"--{k}", v))], capture_output=True, text=True,
+                              timeout=60)
+        assert done.returncode == 2 and says in done.stderr and done.stdout == "", (option, done.stderr)
+
+
+@pytest.mark.parametrize("name", ["a", "a2", "coupling"])
+def test_the_co_simulation_inputs_are_refused_with_the_reason(name):
+    """The FMU's variables that are no parameter of a run: TypeError saying
+    why, as docs/python.md states."""
+    with pytest.raises(TypeError, match=f"^{name}: no parameter of a run; .*a library run has no master"):
+        fraccontact.impact(**{name: 1})
+    prose = " ".join(section("In Python: the `fraccontact` package").split())
+    assert "The FMU's inputs `a`, `a2` and `coupling` are no parameters of a run" in prose

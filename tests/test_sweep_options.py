@@ -1,9 +1,11 @@
-"""Issue 23's sweep defects (items 3, 7, 8, 12, 18): what `fraccontact
+"""The sweep's options (fraccontact/sweep/options.py): what `fraccontact
 sweep` decides before Dask starts is checked in-process, with the cluster
 replaced by a failure (an option that is refused must be refused before
 anything runs); the few behaviours that need a process or a cluster run
-one each. Item 3's limit of 1e6 impacts is gone with the columnar sweep
-(issue 26): what remains is the disk, checked before anything runs."""
+one each. The sizes it refuses: a grid or a Monte Carlo campaign whose
+output the disk cannot hold, checked before anything runs; the grid's
+values, options that would be ignored or contradict each other, the
+output folder and the scheduler; what --help and docs/sweeps.md say."""
 
 import os
 import resource
@@ -65,7 +67,7 @@ def planned(tmp_path, *args):
     return e.value.options, every_case(e.value.plan)
 
 
-# ---------------------------------------------------------------- item 3
+# ---------------------------------------------------------------- sizes: the disk's bound
 
 
 def limited_sweep(*args):
@@ -103,7 +105,7 @@ def test_a_huge_monte_carlo_is_refused(no_cluster, tmp_path, capsys):
 
 @pytest.mark.parametrize("csv", [False, True])
 def test_the_disk_bound_is_where_the_help_says(csv, no_cluster, tmp_path, capsys, monkeypatch):
-    """10^8 impacts run (issue 26) when the disk holds their output: c
+    """10^8 impacts run when the disk holds their output: c
     and the 10 results (t_onset, v_onset, F_peak, eps, t_contact, x2_end,
     E_diss, impacts, steps, k) are 11 values an impact, 8 bytes each in
     Parquet and 25 more in the CSV; one byte less free is refused."""
@@ -140,7 +142,7 @@ def test_the_limits_are_stated_as_the_code_has_them(capsys):
     assert limit in readme_sweep_section() and f"within {sweep.CONNECT_TIMEOUT} s" in readme_sweep_section()
 
 
-# ---------------------------------------------------------------- item 7
+# ---------------------------------------------------------------- a material beside k
 
 
 def test_a_material_beside_k_is_warned_of_once(no_cluster, tmp_path, capsys):
@@ -178,12 +180,12 @@ def test_the_warning_is_printed_once_by_a_real_sweep(tmp_path):
     assert len(rows) == 3 and rows[1].split(",")[1:] == rows[2].split(",")[1:]
 
 
-# ---------------------------------------------------------------- item 8
+# ---------------------------------------------------------------- the grid's values
 
 
 @pytest.mark.parametrize("spec, expected", [
-    ("tolerance=1e-12:4e-12:1.5e-12", [1e-12, 2.5e-12, 4e-12]),  # the issue's: ran 1e-12, 3e-12, 4e-12
-    ("gap0=0:4e-12:1.5e-12", [0.0, 1.5e-12, 3e-12]),  # the issue's: ran 0, 2e-12, 3e-12
+    ("tolerance=1e-12:4e-12:1.5e-12", [1e-12, 2.5e-12, 4e-12]),  # rounding to 12 decimals ran 1e-12, 3e-12, 4e-12
+    ("gap0=0:4e-12:1.5e-12", [0.0, 1.5e-12, 3e-12]),  # rounding to 12 decimals ran 0, 2e-12, 3e-12
     ("R=1e-13:5e-13:1e-13", [1e-13, 2e-13, 3e-13, 4e-13, 5e-13]),
 ])
 def test_small_grid_values_are_the_ones_asked_for(spec, expected, no_cluster, tmp_path):
@@ -214,7 +216,7 @@ def test_a_step_doubles_cannot_resolve_is_refused(no_cluster, tmp_path, capsys):
     assert code == 2 and "--vary c=1:1.0000000000000002:1e-17" in line and "repeat" in line, line
 
 
-# ---------------------------------------------------------------- item 12
+# ---------------------------------------------------------------- options ignored or contradicting
 
 
 @pytest.mark.parametrize("args, message", [
@@ -233,7 +235,7 @@ def test_a_step_doubles_cannot_resolve_is_refused(no_cluster, tmp_path, capsys):
     (["--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers 2 with --scheduler"),
     (["--workers", "100000"], "--workers 100000: a local cluster has 1 to"),
     (["--batch", "-1"], "--batch -1: impacts per Dask task, >= 1"),
-    (["--batch", "0"], "--batch 0: impacts per Dask task, >= 1"),  # issue 35 item 14: 26f430c took it
+    (["--batch", "0"], "--batch 0: impacts per Dask task, >= 1"),  # 26f430c took it
     (["--vary", "c=1:inf:1"], "--vary c=1:inf:1: a grid's start, stop and step are finite"),
 ])
 def test_options_that_would_be_ignored_or_contradict_are_refused(args, message, no_cluster, tmp_path, capsys):
@@ -249,7 +251,7 @@ def test_a_set_height_with_a_grid_is_held(no_cluster, tmp_path):
     assert cases == [{"c": 3000.0}, {"c": 6080.0}] and args.fixed["height"] == 0.02
 
 
-# ---------------------------------------------------------------- item 18
+# ---------------------------------------------------------------- the output folder and the scheduler
 
 
 @pytest.mark.parametrize("make, message", [
@@ -288,7 +290,7 @@ def test_the_drift_the_readme_shows():
     assert repr(0.005 + 6 * 0.005) == "0.034999999999999996" and "0.034999999999999996" in readme_sweep_section()
 
 
-# ---------------------------------------------------------------- issue 35, item 20
+# ---------------------------------------------------------------- what --help and the docs say
 
 
 def test_help_and_docs_say_where_the_local_workers_run(capsys):

@@ -1,5 +1,5 @@
-"""The console command's defects of issue 23 (items 2, 13, 16, 17, 19, 20,
-23): every bad option or file is one line on stderr naming the option, its
+"""The console command fraccontact (fraccontact/cli.py and the commands it
+runs): every bad option or file is one line on stderr naming the option, its
 value and what is wrong, exit status 2, before anything runs and with
 nothing left on disk; a missing module names the extra that installs it;
 a reader that closes the pipe early gets no traceback; an impact that has
@@ -10,10 +10,8 @@ import json
 import math
 import os
 import pathlib
-import re
 import subprocess
 import sys
-import tomllib
 
 import numpy as np
 import pytest
@@ -24,10 +22,9 @@ if os.environ.get("FRACCONTACT_SANITIZED") == "1":
     # is checked by the normal build's run, the C beneath them by this one's.
     pytest.skip("the commands' Python needs matplotlib, which does not load under ASan", allow_module_level=True)
 
-import fraccontact  # noqa: E402
-from fraccontact import cli, cosim, fit, ssp  # noqa: E402
+from fraccontact import cli, cosim, fit  # noqa: E402
 from fraccontact.reports import calibration, h20_drop, stability  # noqa: E402
-from fraccontact.scenes import masters  # noqa: E402
+from test_package import PYPROJECT  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
@@ -58,7 +55,7 @@ def no_run(*args, **kwargs):
     raise AssertionError("the run started before the options were checked")
 
 
-# Item 2: fraccontact run checks every option before the run.
+# fraccontact run checks every option before the run.
 
 RUN_REFUSED = [
     (["--output-interval", "0"], ["--output-interval", "0 is not positive"]),
@@ -118,7 +115,7 @@ def test_run_says_an_impact_that_has_not_ended_is_the_stop_times(command, tmp_pa
     assert not any(tmp_path.iterdir())
 
 
-# Item 17: the wrong file as an FMU, and values the FMUs refuse.
+# The wrong file as an FMU, and values the FMUs refuse.
 
 def test_run_refuses_the_striker_fmu(command, monkeypatch, tmp_path):
     monkeypatch.setattr(h20_drop, "simulate", no_run)
@@ -184,7 +181,7 @@ def test_cosim_says_what_the_fmu_refused_during_the_run(command):
     one_line(err, "the contact FMU refused v = 1e+295", "exceeds double precision")
 
 
-# Item 13: no eps before an impact has ended.
+# No eps before an impact has ended.
 
 @pytest.mark.parametrize("t_end, says", [("0", "0 is not positive"), ("-1", "-1 is not positive"),
                                          ("nan", "nan is not a finite number")])
@@ -218,7 +215,7 @@ def test_cosim_reports_eps_once_the_impact_has_ended(command):
     assert r["impact_ended"] is True and 0 < r["eps"] < 1 and 0 < r["eps_contact"] < 1
 
 
-# Item 16: the report's folder before the computing; report without NAME.
+# The report's folder before the computing; report without NAME.
 
 class Stop(Exception):
     pass
@@ -253,9 +250,8 @@ def test_report_without_a_name_is_a_usage_error(command):
     assert status == 2 and out == "" and err.startswith("usage: fraccontact report NAME")
 
 
-# Item 19: a missing module names its extra; the package holds what its reports need.
+# A missing module names its extra.
 
-PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 EXTRAS = PYPROJECT["project"]["optional-dependencies"]
 DISTRIBUTION = {"dask": "dask[distributed]", "distributed": "dask[distributed]"}  # module -> requirement
 
@@ -298,38 +294,7 @@ def test_every_command_has_an_extra():
     assert set(cli.EXTRAS) == set(cli.COMMANDS) and set(cli.EXTRAS.values()) <= set(EXTRAS)
 
 
-def test_the_package_ships_the_scene_its_reports_run():
-    """pip install . builds with FRACCONTACT_PACKAGE: the SSPs (the drop
-    test, the crash scenes) are made and installed into the package beside
-    the FMUs, where ssp_path() and scenes.masters.ssp_path() look (scripts/test
-    installs the package and runs the scenes)."""
-    cmake = (ROOT / "CMakeLists.txt").read_text()
-    package = re.search(r"if\(FRACCONTACT_PACKAGE\)\n(.*?)\n  return\(\)", cmake, re.S).group(1)
-    assert "add_subdirectory(ssp)" in package and "include(ssp/scenes.cmake)" in package
-    installed = re.search(r'install\(FILES (.*?) DESTINATION fraccontact\)', package, re.S).group(1)
-    for name in ("${SSP_FILE}", "${FMU_FILE}", "body.fmu", "${SCENE_SSP_FILES}"):
-        assert name in installed, name
-    ssp_cmake = (ROOT / "ssp" / "CMakeLists.txt").read_text()
-    assert 'set(SSP_FILE "${CMAKE_BINARY_DIR}/drop_test.ssp" PARENT_SCOPE)' in ssp_cmake
-    scenes_cmake = (ROOT / "ssp" / "scenes.cmake").read_text()
-    assert "foreach(scene headform bumper)" in scenes_cmake
-    assert 'list(APPEND SCENE_SSP_FILES "${ssp_file}")' in scenes_cmake
-    assert PYPROJECT["tool"]["scikit-build"]["wheel"]["packages"] == ["python/fraccontact"]
-
-
-def test_the_scene_is_found_beside_the_installed_fmus(monkeypatch, tmp_path):
-    """An installed package: no environment variables, the FMUs and the scene in the package's folder."""
-    for name in ("fraccontact.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"):
-        (tmp_path / name).write_bytes(b"")
-    monkeypatch.setattr(fraccontact, "_HERE", tmp_path)
-    for variable in ("FRACCONTACT_FMU", "DROP_TEST_SSP"):
-        monkeypatch.delenv(variable, raising=False)
-    assert ssp.ssp_path() == tmp_path / "drop_test.ssp"
-    for scene in ("headform", "bumper"):
-        assert masters.ssp_path(scene) == tmp_path / f"{scene}.ssp"
-
-
-# Item 20: a closed pipe; the usage line.
+# A closed pipe; the usage line.
 
 @pytest.mark.parametrize("argv", [["fit", "--F-peak", "1004", "--eps", "0.59", "--height", "0.02", "--m", "0.7437"],
                                   ["--help"], ["report", "--help"]], ids=["fit", "help", "report help"])
@@ -351,7 +316,7 @@ def test_the_usage_line_requires_the_command_alone(command):
     assert "the following arguments are required: COMMAND\n" in err and "options" not in err.splitlines()[-1]
 
 
-# Item 23: fit --curve's hints follow what is wrong.
+# fit --curve's hints follow what is wrong.
 
 M, V0 = 0.7437, math.sqrt(2 * 9.81 * 0.020)
 
