@@ -10,7 +10,7 @@ import copy
 
 import pytest
 
-from fraccontact.reports import hostile
+from reports import hostile
 from test_solver import SOLVE
 
 CASES = list(hostile.cases())

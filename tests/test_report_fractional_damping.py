@@ -17,7 +17,7 @@ import pytest
 if os.environ.get("FRACCONTACT_SANITIZED") == "1":
     pytest.skip("matplotlib under a preloaded sanitizer runtime", allow_module_level=True)
 
-from fraccontact.reports import fractional_damping as fd  # noqa: E402
+from reports import fractional_damping as fd  # noqa: E402
 
 
 def rl_exact(f, alpha, t, T):

@@ -20,7 +20,7 @@ import warnings
 
 import pytest
 
-from fraccontact.reports.stability import core, dashpot, springpot, springpot_report
+from reports.stability import core, dashpot, springpot, springpot_report
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOLVER = pathlib.Path(os.environ.get("FRACCONTACT_SOLVE", ROOT / "build" / "fraccontact-solve"))

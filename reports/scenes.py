@@ -16,9 +16,9 @@ import numpy as np
 from scipy.optimize import brentq
 from tqdm import tqdm
 
-from .. import atomic, crash, omsimulator, reports
-from ..scenes import headform, masters, systems
-from ..scenes.parameters import ADULT, CHILD, HIC_LIMITS, SPEEDS
+from fraccontact import atomic, crash, omsimulator, output
+from fraccontact.scenes import headform, masters, systems
+from fraccontact.scenes.parameters import ADULT, CHILD, HIC_LIMITS, SPEEDS
 
 MASTERS = ("fmpy", "libcosim", "container", "container-gs") + (("omsimulator",) if omsimulator.available() else ())
 STEPS = (4e-5, 2e-5, 1e-5, 5e-6)
@@ -107,7 +107,7 @@ def clearances(curves):
 
 
 def plot_hic(curves, path):
-    plt = reports.pyplot()
+    plt = output.pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for name, (ref, cosim) in curves.items():
         line, = ax.semilogy(1e3 * CLEARANCES, ref, label=f"{name}: reference")
@@ -117,11 +117,11 @@ def plot_hic(curves, path):
     ax.set_xlabel("clearance gap0 [mm]")
     ax.set_ylabel("HIC15 (CFC 1000)")
     ax.legend()
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_head(ref, runs, path):
-    plt = reports.pyplot()
+    plt = output.pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4))
     t, a = masters.deceleration(ref, "head")
     ax.plot(1e3 * t, crash.in_g(a), "k", lw=2, label="reference (scipy)")
@@ -132,13 +132,13 @@ def plot_head(ref, runs, path):
     ax.set_ylabel("head deceleration [g], unfiltered")
     ax.set_xlim(0, 30)
     ax.legend()
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def main(argv=None, prog=None):
-    p = reports.parser(prog, __doc__)
+    p = output.parser(prog, __doc__)
     args = p.parse_args(argv)
-    reports.make_folder(p, args.out)
+    output.make_folder(p, args.out)
     out = args.out
     with tqdm(total=2 * len(STEPS) * len(MASTERS) + 2 * len(CLEARANCES), desc="scenes", unit="run") as bar:
         head_rows, head_ref, head_runs = side_by_side("headform", HEADFORM_FIGURES)

@@ -8,7 +8,8 @@ import dataclasses
 import functools
 import math
 
-from ... import hertz, model, solver
+from fraccontact import hertz, model, solver
+
 from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 
 # The paper's h20 test; a case changes some of these (v0 is the library's v, dt its dt_max).

@@ -31,16 +31,17 @@ Regenerate: scripts/report stability   (pytest runs the FAST subset)
 
 import time
 
-from ... import atomic, reports
+from fraccontact import atomic, output
+
 from . import dashpot, dashpot_report, springpot, springpot_report
 from .core import over
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser, "fraccontact-solve, for its GSL reference")
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser, "fraccontact-solve, for its GSL reference")
     parser.add_argument("--fast", action="store_true", help="the subset pytest runs")
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     # The dashpot: its convergence study, then its matrix, every case with every law.
     start = time.monotonic()
     study = over(dashpot.CONVERGENCE, args.fast, dashpot.FAST_CONVERGENCE, "convergence: ",

@@ -35,8 +35,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .. import _lib, atomic, reports
-from ..sweep import cases, options, tasks
+from fraccontact import _lib, atomic, output
+from fraccontact.sweep import cases, options, tasks
+
 from .benchmarks import SWEEP_BEGIN, SWEEP_END, LoadWatch, git, replace_section, say
 
 SETTING = ["--scatter", "k=0.05", "--scatter", "c=10%", "--set", "law=2", "--set", "tolerance=3e-8",
@@ -361,7 +362,7 @@ def benchmark_section(f, load, head):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
+    parser = output.parser(prog, __doc__)
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()

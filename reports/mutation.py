@@ -45,7 +45,8 @@ import tempfile
 import threading
 import time
 
-from .. import atomic
+from fraccontact import atomic
+
 from . import source_tree
 
 ROOT = source_tree()

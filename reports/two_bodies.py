@@ -13,8 +13,8 @@ Regenerate: scripts/report two_bodies   (about 10 s of CPU)
 
 import math
 
-from .. import atomic, reports
-from ..cosim import M, T_END, V0, add_fmu_options, cosimulate, fmu_paths, monolithic, spring_reference
+from fraccontact import atomic, output
+from fraccontact.cosim import M, T_END, V0, add_fmu_options, cosimulate, fmu_paths, monolithic, spring_reference
 
 M1, M2, V = 4.5, 2.0, 2.0                 # the issue's case: 4.5 kg on a free 2 kg at 2 m/s
 ROUNDING = 1e-12                          # an energy error within the energies' rounding over a run
@@ -167,9 +167,9 @@ def write(path, free_ref, free_rows, spring_ref, table):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
+    parser = output.parser(prog, __doc__)
     add_fmu_options(parser)
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     contact, striker = fmu_paths(parser, args)
     free_ref, free_rows = free_bodies(contact, striker)
     spring_ref = spring_reference(K_S)

@@ -19,10 +19,10 @@ import numpy as np
 
 import matplotlib.ticker
 
-from .. import atomic, model, reports, solver
-from ..fmu import Slave, unpacked
+from fraccontact import atomic, model, output, solver
+from fraccontact.fmu import Slave, unpacked
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 H20 = model.defaults()
 M, V0, C = H20["m"], H20["v"], H20["c"]
@@ -468,7 +468,7 @@ def plot_curves(path, series, omega):
     ax_t.legend(fontsize=8)
     fig.suptitle(f"h20 drop test with a springpot, c_alpha = c omega^(1-alpha), c = {C:g} N s/m, "
                  f"omega = {omega:.0f} rad/s")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_heights(path, h):
@@ -493,7 +493,7 @@ def plot_heights(path, h):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.suptitle(f"Drop heights 5 to 100 mm (m = {M:g} kg, k = {H20['k']:.4g} N/m^1.5, n = 1.5)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_recovery(path, rec, sc):
@@ -529,7 +529,7 @@ def plot_recovery(path, rec, sc):
              title="Second contact under gravity: it begins where x = x2")
     ax_s.grid(alpha=0.3)
     ax_s.legend(fontsize=8)
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_cost(path, rows, sizes, bench_json):
@@ -559,7 +559,7 @@ def plot_cost(path, rows, sizes, bench_json):
     for ax in (ax_c, ax_s):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_memory(path, k, agree, lad):
@@ -596,7 +596,7 @@ def plot_memory(path, k, agree, lad):
     for ax in (ax_m, ax_a, ax_l):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, loc="upper left" if ax is ax_l else "best")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 # ------------------------------------------------------------ the report
@@ -1004,7 +1004,7 @@ def write_report(args):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_fmu(parser)
-    args = reports.parse(parser, argv)
+    parser = output.parser(prog, __doc__)
+    output.add_fmu(parser)
+    args = output.parse(parser, argv)
     write_report(args)

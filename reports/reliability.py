@@ -17,8 +17,10 @@ import sys
 
 from tqdm import tqdm
 
-from .. import atomic
-from . import BAR, make_folder, source_tree
+from fraccontact import atomic
+from fraccontact.output import make_folder
+
+from . import BAR, source_tree
 
 ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",

@@ -49,10 +49,10 @@ from scipy.special import gamma
 
 import differint.differint as differint
 
-from .. import atomic, fit, fmu, model, reports, solver
-from ..scipy_contact import solve_drop
+from fraccontact import atomic, fit, fmu, model, output, solver
+from fraccontact.scipy_contact import solve_drop
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 TARGET = 1e-6
 # Section 4: (label, law, dt_max, impacts in one fraccontact.impacts call,
@@ -366,7 +366,7 @@ def plot_precision(path, r):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
     fig.suptitle("Work against precision (gray: 1e-6; ringed: the cheapest setting meeting it)")
-    reports.save(fig, path, rect=(0, 0.08, 1, 1))
+    output.save(fig, path, rect=(0, 0.08, 1, 1))
 
 
 def precision(root, program, bench, fmu_file, out):
@@ -1323,9 +1323,9 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
-    reports.add_fmu(parser)
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
+    output.add_fmu(parser)
     parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions"],
                         help="regenerate one section alone, in place (precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
@@ -1334,11 +1334,11 @@ def main(argv=None, prog=None):
                              "instructions: the instruction counts of the guard's runs, and issue 35's table)")
     parser.add_argument("--largest-n", type=float, default=1e6,
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     program, bench = args.solver, solver.bench_path(args.solver)
     if args.only == "precision":
         say("work against precision ...")
-        section = precision(reports.source_tree(), program, bench, args.fmu, args.out)
+        section = precision(source_tree(), program, bench, args.fmu, args.out)
         replace_section(args.out / "benchmarks.md", section, PRECISION_BEGIN, PRECISION_END)
         print((args.out / "benchmarks.md").read_text())
         return
@@ -1349,7 +1349,7 @@ def main(argv=None, prog=None):
         return
     if args.only == "springpot":
         say("the springpot ...")
-        section = springpot_section(springpot_rows(reports.source_tree(), bench, args.fmu, args.largest_n))
+        section = springpot_section(springpot_rows(source_tree(), bench, args.fmu, args.largest_n))
         replace_section(args.out / "benchmarks.md", section, SPRINGPOT_BEGIN, SPRINGPOT_END)
         print((args.out / "benchmarks.md").read_text())
         return
@@ -1361,11 +1361,11 @@ def main(argv=None, prog=None):
         return
     if args.only == "instructions":
         say("instruction counts ...")
-        section = instructions_section(instruction_rows(reports.source_tree(), program, args.fmu))
+        section = instructions_section(instruction_rows(source_tree(), program, args.fmu))
         replace_section(args.out / "benchmarks.md", section, INSTRUCTIONS_BEGIN, INSTRUCTIONS_END)
         print((args.out / "benchmarks.md").read_text())
         return
-    root = reports.source_tree()
+    root = source_tree()
     say("1/5 cost of a step ...")
     steps = step_costs(bench)
     say("2/5 work against precision ...")

@@ -18,10 +18,10 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from .. import atomic, model, reports, solver
-from ..scipy_contact import solve_drop
+from fraccontact import atomic, model, output, solver
+from fraccontact.scipy_contact import solve_drop
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 H20 = model.defaults()
 K, C, M, V0 = H20["k"], H20["c"], H20["m"], H20["v"]
@@ -109,9 +109,9 @@ def observed_order(dts, errs):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser)
-    args = reports.parse(parser, argv)
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser)
+    args = output.parse(parser, argv)
     tmp = pathlib.Path(tempfile.mkdtemp())
 
     ref = run(args.solver, "--reference", "--law", "hertz", "--csv", tmp / "ref.csv", "--output-interval", GRID)
@@ -185,7 +185,7 @@ def plot(path, results, adaptive_rows, scipy_rows, gsl_rows):
     axes.flat[-1].legend(handles, labels, loc="center", fontsize=9)
     fig.suptitle("Error against CPU time, h20 drop test (fixed internal steps 1e-5 s ... 1.2e-9 s; "
                  "gray line: 1e-6)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def fmt(x):
