@@ -26,8 +26,8 @@ def source_tree():
 
 
 def names():
-    """The reports: the modules of this folder."""
-    return sorted(m.name for m in pkgutil.iter_modules(__path__))
+    """The reports: the modules of this folder (not __main__)."""
+    return sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_"))
 
 
 def missing_module_hint(prog, error):

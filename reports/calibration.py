@@ -62,7 +62,7 @@ def plot(path, paper_rows, fitted_rows):
     output.save(fig, path)
 
 
-# The springpot (issue 12, item 7): the h20 row cannot identify k, c_alpha and alpha.
+# The springpot: the h20 row cannot identify k, c_alpha and alpha.
 
 SHOWN = (1.0, 0.8, 0.6, 0.45, 0.35, 0.3)   # the family's members drawn and tabled in full
 TRUTH_ALPHA = 0.6                         # the member whose data the identifiability section fits

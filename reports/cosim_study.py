@@ -284,7 +284,7 @@ def write(path, results, forced, ref, ref_g, scene, g1, spring):
         a, b = at(ours, H), at(theirs, H)
         out.append(f"| {H:g} | {a['F_peak_error']:.1e} | {a['eps_error']:.1e} | {a['energy_error']:.2e} | "
                    f"{b['F_peak_error']:.1e} | {b['eps_error']:.1e} | {b['energy_error']:.2e} |")
-    out += ["", f"- **Exact at every step**: the issue's target is 1e-3 in F_peak and eps at H = 1e-4 s; the "
+    out += ["", f"- **Exact at every step**: the target is 1e-3 in F_peak and eps at H = 1e-4 s; the "
             f"coupling meets it at every H of the ladder up to 1e-3 s, where the impact spans two steps, with "
             f"errors of {worst(ours)} (our driver) and {worst(theirs)} (libcosim): rounding where H is a multiple of "
             "dt_max, and the scheme's O(dt^2) difference of internal steps elsewhere (the contact splits H into "

@@ -1,4 +1,4 @@
-"""Fractional damping (issue 12, item 8): the springpot F = c_alpha D^alpha x2
+"""Fractional damping: the springpot F = c_alpha D^alpha x2
 against the dashpot on the paper's drop test. Force curves and hysteresis
 loops for alpha from 0.1 to 1; restitution and peak force against drop height
 (5 to 100 mm); the dent's recovery after separation and the second contact
@@ -422,7 +422,7 @@ def memory_agreement():
 
 def ladder():
     """Section 5c: both memories over dt_max. The default spring (law 1, the
-    G1 law) for the issue's criterion; the closed-form Hertz spring (law 2)
+    G1 law) for the accuracy criterion; the closed-form Hertz spring (law 2)
     and tolerance 1e-12 to see each memory's own time-stepping error, against
     the compressed memory at its finest step (1.6e-9 s, ~900 000 steps)."""
     default = {dt: dict(full=model.impact(damper=2, memory=1, dt_max=dt),
@@ -642,10 +642,10 @@ def section_curves(series, omega, one):
               "conservative. With the closed-form Hertz spring (law 2) the balance holds to "
               f"{e(abs(hertz[0]), 1)} (dashpot) and {e(abs(hertz[1]), 1)} (springpot 0.5). The springpot at alpha = 1 "
               f"(c_1 = c) against the dashpot, every internal step ({one['rows'][0]} and {one['rows'][1]} rows): "
-              + ("identical, bit for bit (the issue asks for 1e-9 relative)."
+              + ("identical, bit for bit (the target is 1e-9 relative)."
                  if one["dF"] == one["F_peak"] == one["eps"] == 0 else
                  f"the largest force difference is {e(one['dF'])} of F_peak, F_peak differs by {e(one['F_peak'])}, "
-                 f"eps by {e(one['eps'])} (relative; the issue asks for 1e-9)."), ""]
+                 f"eps by {e(one['eps'])} (relative; the target is 1e-9)."), ""]
     return lines
 
 
@@ -808,9 +808,9 @@ def bench_lines(bench_json):
     ladder = bench_json["ladder"]
     growth = log_slope([r["N"] for r in ladder], [r["full"]["seconds"] / r["compressed"]["seconds"] for r in ladder])
     lines += ["", f"At h20 the compressed memory's step costs {c['ns_per_step'] / d['ns_per_step']:.2f} times the "
-              "dashpot's (the issue asks for at most 5) and the full history's "
+              "dashpot's (the target is at most 5) and the full history's "
               f"{f['ns_per_step'] / c['ns_per_step']:.0f} times the compressed one's. The speed-up of the "
-              f"compressed memory per impact grows as N^{growth:.2f} (like N, as the issue expects). The "
+              f"compressed memory per impact grows as N^{growth:.2f} (like N, as expected). The "
               "compressed memory steps less often than N over the span: after separation it takes growing "
               "recovery steps (section 3) where the full history keeps stepping dt_max. "
               "`docs/benchmarks.md` carries the same subcommand's ladder to 1e6.", ""]
@@ -908,7 +908,7 @@ def section_memory(k, agree, lad):
               "delta/T = 1e-10) needs 58."]
     d = lad["default"]
     lines += ["", "### Against the full history over the step", "",
-              "The issue's criterion, at the defaults (alpha 0.5, c_alpha 3e5, G1 spring law 1, tolerance 1e-6):", "",
+              "The accuracy criterion, at the defaults (alpha 0.5, c_alpha 3e5, G1 spring law 1, tolerance 1e-6):", "",
               "| dt_max [s] | steps | F_peak, memory 1 [N] | F_peak, memory 2 [N] | relative difference | "
               "eps, memory 1 | eps, memory 2 | relative difference |", "|---|---|---|---|---|---|---|---|"]
     diffs = []

@@ -689,7 +689,7 @@ def main(argv=None, prog=None):
         expected[verdict_of(c)] = expected.get(verdict_of(c), 0) + 1
         observed[r["observed"]] = observed.get(r["observed"], 0) + 1
     out = ["# Hostile and degenerate input", "",
-           "Regenerate: `scripts/report hostile` (`fraccontact/reports/hostile.py`; pytest runs the same cases and "
+           "Regenerate: `scripts/report hostile` (`reports/hostile.py`; pytest runs the same cases and "
            "checks, "
            "`tests/test_hostile.py`). Each case runs through fmpy in a process of its own, over 2 ms of the h20 "
            "drop test unless stated, and states the verdict it must reach:", "",

@@ -200,7 +200,7 @@ def main(argv=None, prog=None):
         f = fuzz(args.fuzz_seconds)
         bar.update()
         bar.set_description("hostile input")
-        done = subprocess.run([sys.executable, "-m", "fraccontact", "report", "hostile", "--out", args.out],
+        done = subprocess.run([sys.executable, "-m", "reports", "hostile", "--out", args.out],
                               capture_output=True, text=True)
         bar.update()
     summary = done.stdout.strip().splitlines()[0] if done.stdout.strip() else "the hostile report failed"

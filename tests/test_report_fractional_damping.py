@@ -1,4 +1,4 @@
-"""The fractional-damping report's own arithmetic (fraccontact/reports/
+"""The fractional-damping report's own arithmetic (reports/
 fractional_damping.py), against closed forms: the Riemann-Liouville integral of
 a piecewise-linear force (its recovery prediction x2 = I^alpha F / c_alpha),
 computed independently with mpmath; the kernel error of an exact kernel; the
