@@ -1,5 +1,5 @@
 /* fraccontact-bench: timings for docs/benchmarks.md
- * (python/fraccontact/reports/benchmarks.py runs it; not a test). Prints one JSON object.
+ * (reports/benchmarks.py runs it; not a test). Prints one JSON object.
  *   fraccontact-bench step           ns per internal step of each law, and of
  *                                     the literal O(N) G1 sum per step
  *   fraccontact-bench g1 N ALPHA      the bare G1 history sum of f(x) = x on

@@ -1,4 +1,4 @@
-/* fraccontact-soak: scale and endurance of the FMU (python/fraccontact/reports/reliability.py
+/* fraccontact-soak: scale and endurance of the FMU (reports/reliability.py
  * runs it for docs/reliability.md, and
  * tests/test_reliability_claims.py checks its memory per instance). Prints one JSON object.
  *   fraccontact-soak instances N      N instances alive at once, each through an impact (and the

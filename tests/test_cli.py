@@ -22,8 +22,10 @@ if os.environ.get("FRACCONTACT_SANITIZED") == "1":
     # is checked by the normal build's run, the C beneath them by this one's.
     pytest.skip("the commands' Python needs matplotlib, which does not load under ASan", allow_module_level=True)
 
-from fraccontact import cli, cosim, fit  # noqa: E402
-from fraccontact.reports import calibration, h20_drop, stability  # noqa: E402
+import reports  # noqa: E402
+from fraccontact import cli, cosim, fit, output  # noqa: E402
+from fraccontact import run as h20_drop  # noqa: E402
+from reports import calibration, stability  # noqa: E402
 from test_package import PYPROJECT  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -31,17 +33,26 @@ CONTACT = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fracc
 STRIKER = pathlib.Path(os.environ.get("STRIKER_FMU", ROOT / "build" / "striker.fmu"))
 
 
+def outcome(capsys, main, argv):
+    """(exit status, stdout, stderr) of main(argv) in this process."""
+    try:
+        status = main([str(a) for a in argv])
+    except SystemExit as e:
+        status = e.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
 @pytest.fixture
 def command(capsys):
     """command(*argv) -> (exit status, stdout, stderr) of fraccontact run in this process."""
-    def run(*argv):
-        try:
-            status = cli.main([str(a) for a in argv])
-        except SystemExit as e:
-            status = e.code
-        out, err = capsys.readouterr()
-        return status, out, err
-    return run
+    return lambda *argv: outcome(capsys, cli.main, argv)
+
+
+@pytest.fixture
+def report(capsys):
+    """report(*argv) -> the same of scripts/report (python -m reports) in this process."""
+    return lambda *argv: outcome(capsys, reports.main, argv)
 
 
 def one_line(err, *says):
@@ -84,7 +95,7 @@ def test_run_bounds_the_rows_where_its_help_says(command, stop_time, refused):
     rows of fmpy's tuples, some 400 bytes each, fit in memory."""
     status, out, err = command("run", "--help")
     assert status == 0 and "at most 1e+06 rows: stop time / interval" in " ".join(out.split())
-    parser = h20_drop.reports.parser("fraccontact run", "")
+    parser = output.parser("fraccontact run", "")
     args = argparse.Namespace(fmu=CONTACT, stop_time=stop_time, output_interval=1e-6)
     if refused:
         with pytest.raises(SystemExit):
@@ -221,8 +232,8 @@ class Stop(Exception):
     pass
 
 
-@pytest.mark.parametrize("report", ["calibration", "stability"])
-def test_a_report_makes_its_folder_before_computing(command, monkeypatch, tmp_path, report):
+@pytest.mark.parametrize("name", ["calibration", "stability"])
+def test_a_report_makes_its_folder_before_computing(report, monkeypatch, tmp_path, name):
     out = tmp_path / "a" / "b"
     seen = []
 
@@ -231,23 +242,23 @@ def test_a_report_makes_its_folder_before_computing(command, monkeypatch, tmp_pa
         raise Stop
 
     monkeypatch.setattr(*{"calibration": (calibration, "write_report"),
-                          "stability": (stability.dashpot, "convergence")}[report], first_computation)
+                          "stability": (stability.dashpot, "convergence")}[name], first_computation)
     with pytest.raises(Stop):
-        command("report", report, "--out", out)
+        report(name, "--out", out)
     assert seen == [True]
 
 
-def test_a_report_refuses_a_folder_it_cannot_make(command, monkeypatch, tmp_path):
+def test_a_report_refuses_a_folder_it_cannot_make(report, monkeypatch, tmp_path):
     monkeypatch.setattr(calibration, "write_report", no_run)
     (tmp_path / "file").write_text("")
-    status, out, err = command("report", "calibration", "--out", tmp_path / "file" / "sub")
+    status, out, err = report("calibration", "--out", tmp_path / "file" / "sub")
     assert status == 2 and out == ""
     one_line(err, f"--out {tmp_path / 'file' / 'sub'}: cannot make the folder")
 
 
-def test_report_without_a_name_is_a_usage_error(command):
-    status, out, err = command("report")
-    assert status == 2 and out == "" and err.startswith("usage: fraccontact report NAME")
+def test_report_without_a_name_is_a_usage_error(report):
+    status, out, err = report()
+    assert status == 2 and out == "" and err.startswith("usage: scripts/report NAME")
 
 
 # A missing module names its extra.
@@ -259,20 +270,23 @@ DISTRIBUTION = {"dask": "dask[distributed]", "distributed": "dask[distributed]"}
 MISSING = [(["run"], "fmpy"), (["run"], "matplotlib"), (["fit", "--F-peak", "1004", "--eps", "0.59", "--height",
                                                          "0.02", "--m", "0.7437"], "scipy"),
            (["sweep"], "dask"), (["cosim"], "fmpy"), (["cosim"], "scipy"),
-           (["cosim", "--order", "libcosim", "--coupling", "predictive"], "libcosimpy"),
-           (["report", "calibration"], "matplotlib"), (["report", "benchmarks"], "differint")]
+           (["cosim", "--order", "libcosim", "--coupling", "predictive"], "libcosimpy")]
+# (report, a module it imports)
+REPORT_MISSING = [("calibration", "matplotlib"), ("benchmarks", "differint")]
+REQUIREMENTS = {line.partition("==")[0].lower() for line in (ROOT / "requirements.txt").read_text().splitlines()
+                if line and not line.startswith("#")}
 
 
 def block(monkeypatch, module):
     """As if the module were not installed: it and its submodules cannot be
-    imported, and the package's modules are imported afresh (each restored
+    imported, and the package's and the reports' modules are imported afresh (each restored
     after the test)."""
     monkeypatch.setitem(sys.modules, module, None)
     for name in list(sys.modules):
         if name.startswith(module + "."):
             monkeypatch.setitem(sys.modules, name, None)
-        elif name.startswith("fraccontact.") and name not in ("fraccontact.cli", "fraccontact.model",
-                                                               "fraccontact._lib", "fraccontact.reports"):
+        elif name.startswith(("fraccontact.", "reports.")) and name not in ("fraccontact.cli", "fraccontact.model",
+                                                                            "fraccontact._lib"):
             parent, _, child = name.rpartition(".")
             if parent in sys.modules and hasattr(sys.modules[parent], child):  # a removed parent is made afresh
                 monkeypatch.setattr(sys.modules[parent], child, getattr(sys.modules[parent], child))
@@ -285,9 +299,18 @@ def test_a_missing_module_names_the_extra_that_installs_it(command, monkeypatch,
     status, out, err = command(*argv)
     extra = cli.EXTRAS[argv[0]]
     assert status == 2 and out == ""
-    assert err == f"fraccontact {' '.join(argv[:2]) if argv[0] == 'report' else argv[0]} needs {module}, which is " \
-                  f"not installed: pip install 'fraccontact[{extra}]'\n"
+    assert err == f"fraccontact {argv[0]} needs {module}, which is not installed: pip install 'fraccontact[{extra}]'\n"
     assert DISTRIBUTION.get(module, module) in EXTRAS[extra]  # and that extra installs it
+
+
+@pytest.mark.parametrize("name, module", REPORT_MISSING, ids=[f"{n}-{m}" for n, m in REPORT_MISSING])
+def test_a_report_names_what_installs_a_missing_module(report, monkeypatch, name, module):
+    block(monkeypatch, module)
+    status, out, err = report(name)
+    assert status == 2 and out == ""
+    assert err == f"scripts/report {name} needs {module}, which is not installed: scripts/setup installs it " \
+                  f"(requirements.txt)\n"
+    assert module in REQUIREMENTS  # and scripts/setup installs it
 
 
 def test_every_command_has_an_extra():
@@ -296,12 +319,13 @@ def test_every_command_has_an_extra():
 
 # A closed pipe; the usage line.
 
-@pytest.mark.parametrize("argv", [["fit", "--F-peak", "1004", "--eps", "0.59", "--height", "0.02", "--m", "0.7437"],
-                                  ["--help"], ["report", "--help"]], ids=["fit", "help", "report help"])
+@pytest.mark.parametrize("argv", [["fraccontact", "fit", "--F-peak", "1004", "--eps", "0.59", "--height", "0.02", "--m",
+                                   "0.7437"], ["fraccontact", "--help"], ["reports", "--help"]],
+                         ids=["fit", "help", "report help"])
 def test_a_closed_pipe_ends_the_command_quietly(argv):
     """fraccontact ... | head -3, the reader gone before the command writes
     (it closes its end at once; the command needs a second to start)."""
-    child = subprocess.Popen([sys.executable, "-m", "fraccontact", *argv], stdout=subprocess.PIPE,
+    child = subprocess.Popen([sys.executable, "-m", *argv], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
     child.stdout.close()
     err = child.stderr.read()

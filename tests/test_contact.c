@@ -29,7 +29,7 @@ static double hertz_contact_time(double k)
 /* Rounding: a step rounds each of v, x1, x2 and E_diss once or twice by at
  * most half an ulp of the value, and an energy doubles the velocity's
  * relative error: 4 ulp per step bounds what rounding alone accumulates,
- * relative to the figure's scale (python/fraccontact/reports/stability/core.py,
+ * relative to the figure's scale (reports/stability/core.py,
  * ROUNDING_ULPS). */
 static double rounding(int64_t steps)
 {
@@ -141,7 +141,7 @@ static void test_elastic_limit(void)
 }
 
 /* Known findings (docs/stability.md,
- * python/fraccontact/reports/stability/dashpot.py KNOWN): runs that
+ * reports/stability/dashpot.py KNOWN): runs that
  * fail a check the model satisfies, because of the time scheme. They must
  * still fail (a fix shows up here: remove the entry); every other run must
  * pass. ENERGY: SDIRK2 gains energy in nearly elastic Hertz impacts, about

@@ -1,16 +1,16 @@
-"""Hostile and degenerate input (fraccontact/reports/hostile.py, whose report is
+"""Hostile and degenerate input (reports/hostile.py, whose report is
 docs/reliability_hostile.md), in-process: every case reaches the verdict it
 states, refused (when set, at initialization or by the step: fmi2Error, a
 message naming the variable and value, the old value or state kept, the
 instance usable) or run (finite outputs, F >= 0, agreeing with the GSL
 reference, scipy, a closed form or the physical identities, at the
-tolerances derived in fraccontact/reports/hostile.py)."""
+tolerances derived in reports/hostile.py)."""
 
 import copy
 
 import pytest
 
-from fraccontact.reports import hostile
+from reports import hostile
 from test_solver import SOLVE
 
 CASES = list(hostile.cases())

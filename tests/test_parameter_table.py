@@ -18,7 +18,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 import fraccontact
-from fraccontact.reports import variables
+from reports import variables
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 TABLE = variables.read_table(ROOT / "docs" / "parameters.tsv")

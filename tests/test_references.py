@@ -18,7 +18,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SUFFIXES = (".c", ".h", ".py", ".md", ".xml", ".cmake", ".ssd", ".ssv", ".toml")
 # Folders of the repository a path may start with (build/ holds what the
 # build makes, not sources, and is not checked).
-TOP = ("docs", "scripts", "python", "tests", "solver", "fmu_src", "ssp", "striker", "fmi3", "cmake")
+TOP = ("docs", "scripts", "python", "reports", "tests", "solver", "fmu_src", "ssp", "striker", "fmi3", "cmake")
 PATH = re.compile(r"(?<![\w./~$-])((?:%s)/[\w./*\[\]${}-]*)" % "|".join(TOP))
 # A .py file named with a folder but not from the top (fraccontact/cosim.py,
 # reports/stability.py): some file of the repository must end so.

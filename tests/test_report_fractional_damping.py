@@ -1,4 +1,4 @@
-"""The fractional-damping report's own arithmetic (fraccontact/reports/
+"""The fractional-damping report's own arithmetic (reports/
 fractional_damping.py), against closed forms: the Riemann-Liouville integral of
 a piecewise-linear force (its recovery prediction x2 = I^alpha F / c_alpha),
 computed independently with mpmath; the kernel error of an exact kernel; the
@@ -17,7 +17,7 @@ import pytest
 if os.environ.get("FRACCONTACT_SANITIZED") == "1":
     pytest.skip("matplotlib under a preloaded sanitizer runtime", allow_module_level=True)
 
-from fraccontact.reports import fractional_damping as fd  # noqa: E402
+from reports import fractional_damping as fd  # noqa: E402
 
 
 def rl_exact(f, alpha, t, T):

@@ -1,4 +1,4 @@
-"""The fast subset of the stability matrix (fraccontact/reports/stability/; the full
+"""The fast subset of the stability matrix (reports/stability/; the full
 matrix is docs/stability.md): extreme dashpots, foam and steel, 0.1 mm/s to
 30 m/s, 1 g to 1 t, steps from 1 ns to longer than the contact, N = 1e6,
 rest under gravity, a gap, repeated impacts; each with the G1 and the Hertz
@@ -20,7 +20,7 @@ import warnings
 
 import pytest
 
-from fraccontact.reports.stability import core, dashpot, springpot, springpot_report
+from reports.stability import core, dashpot, springpot, springpot_report
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOLVER = pathlib.Path(os.environ.get("FRACCONTACT_SOLVE", ROOT / "build" / "fraccontact-solve"))

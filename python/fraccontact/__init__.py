@@ -12,7 +12,7 @@ The model runs in-process on its C library:
 Results read by attribute or key alike (r.F_peak, r["F_peak"]); their
 fields are listed in fraccontact.model's docstring. The console command
 `fraccontact` (python -m fraccontact) runs the h20 example, fits, sweeps,
-co-simulations and the reports (fraccontact --help).
+co-simulations and the crash scenes (fraccontact --help).
 """
 
 import os

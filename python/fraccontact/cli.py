@@ -5,36 +5,27 @@ names (--m, --v, --c, --E-s, --t-end: '-' for '_')."""
 import argparse
 import importlib
 import os
-import pkgutil
 import sys
 
-from . import reports
-
 COMMANDS = {
-    "run": "the paper's h20 drop test through the FMU: figures, docs/h20_drop.csv and .png (report h20_drop)",
+    "run": "the paper's h20 drop test through the FMU: figures, docs/h20_drop.csv and .png",
     "fit": "k and a dashpot (c) or springpot (c_alpha, alpha), and E_s, from drop tests (F_peak and eps, a table "
            "of heights) or measured force curves",
     "sweep": "parameter sweeps and Monte Carlo campaigns on Dask, a library call per task",
     "cosim": "the drop test as two FMUs (striker + contact) coupled through fmpy or libcosim",
     "scene": "a crash scene (headform, bumper) as its SSP in fmpy, libcosim, a container FMU, or its reference",
-    "report": "regenerate a report under docs/: fraccontact report NAME [OPTIONS...]",
 }
-MODULES = {"run": "fraccontact.reports.h20_drop", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
+MODULES = {"run": "fraccontact.run", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
            "cosim": "fraccontact.cosim", "scene": "fraccontact.scenes.cli"}
 # The extra of pyproject.toml's optional-dependencies that installs what each command imports.
-EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "scene": "cosim", "report": "reports"}
-
-
-def report_names():
-    """The reports: the modules of fraccontact.reports."""
-    return sorted(m.name for m in pkgutil.iter_modules(reports.__path__))
+EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "scene": "cosim"}
 
 
 def parser():
     commands = "".join(f"  {name:<8} {what}\n" for name, what in COMMANDS.items())
     p = argparse.ArgumentParser(prog="fraccontact", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                epilog=f"commands:\n{commands}\nreports: {', '.join(report_names())}")
+                                epilog=f"commands:\n{commands}")
     p.add_argument("command", choices=COMMANDS, metavar="COMMAND", help="one of " + ", ".join(COMMANDS))
     options = p.add_argument("options", nargs=argparse.REMAINDER, help="the command's options (COMMAND --help)")
     options.required = False  # argparse calls a REMAINDER positional required, yet it may be empty
@@ -54,21 +45,8 @@ def missing_module_hint(prog, command, error):
 def run(argv):
     args = parser().parse_args(argv)
     prog = f"fraccontact {args.command}"
-    options = args.options
-    if args.command == "report":
-        names = report_names()
-        if not options or options[0] in ("-h", "--help"):
-            print(f"usage: {prog} NAME [OPTIONS...]\n\nRegenerates a report (NAME --help for its own).\n"
-                  f"NAME: {' | '.join(names)}", file=sys.stdout if options else sys.stderr)
-            return 0 if options else 2
-        if options[0] not in names:
-            print(f"{prog}: no report '{options[0]}'; NAME is one of {', '.join(names)}", file=sys.stderr)
-            return 2
-        module, prog, options = f"{reports.__name__}.{options[0]}", f"{prog} {options[0]}", options[1:]
-    else:
-        module = MODULES[args.command]
     try:
-        return importlib.import_module(module).main(options, prog=prog) or 0
+        return importlib.import_module(MODULES[args.command]).main(args.options, prog=prog) or 0
     except ModuleNotFoundError as e:
         hint = missing_module_hint(prog, args.command, e)
         if hint is None:
@@ -78,8 +56,14 @@ def run(argv):
 
 
 def main(argv=None):
+    return quiet_on_closed_pipe(run, argv)
+
+
+def quiet_on_closed_pipe(command, argv):
+    """command(argv)'s exit status; 1, and no traceback, where the reader of
+    its output has gone."""
     try:
-        status = run(argv)
+        status = command(argv)
         sys.stdout.flush()  # here, where a closed pipe can still be caught, not at the interpreter's exit
         return status
     except BrokenPipeError:

@@ -132,7 +132,7 @@ def system_name(ssp):
 
 def simulate(ssp, H, t, start, recorded):
     """A trace of the SSP in OMSimulator's fixed-step master at step H: t
-    (its communication points n H from 0, scenes.masters.grid) and each
+    (its communication points n H from 0, ssp.grid) and each
     recorded variable ("component.variable") at them; start ({component:
     {variable: value}}) overrides the SSV bindings."""
     lib = load()

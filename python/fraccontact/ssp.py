@@ -8,8 +8,11 @@ so the results are those of fraccontact.cosim's Jacobi order, predictive
 coupling. Used by the cosim_study report and tests/test_ssp.py.
 """
 
+import math
 import os
 import pathlib
+
+import numpy as np
 
 from . import fmu_path
 from .cosim import M, V0
@@ -83,10 +86,15 @@ def run_libcosim(ssp, H, t_end=T_END):
     return dict(summary(F_peak, E_diss, v_end), applied=applied)
 
 
+def grid(H, t_end):
+    """A fixed-step master's communication points 0, H, ..., N H with N H the last <= t_end."""
+    n = int(math.floor(t_end / H * (1 + 1e-12)))
+    return np.arange(n + 1) * H
+
+
 def run_omsimulator(ssp, H, t_end=T_END):
     """The scene in OMSimulator's fixed-step master (it applies the parameter
     bindings itself) at step H instead of the SSD's."""
     from .omsimulator import simulate
-    from .scenes.masters import grid
     trace = simulate(ssp, H, grid(H, t_end), {}, ("contact.F_peak", "contact.E_diss", "striker.v"))
     return summary(trace["contact.F_peak"][-1], trace["contact.E_diss"][-1], trace["striker.v"][-1])

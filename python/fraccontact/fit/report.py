@@ -5,7 +5,7 @@ measured data against the fitted model's."""
 import numpy as np
 
 from .. import hertz, model
-from ..reports import pyplot, save, significant, with_error
+from ..output import pyplot, save, significant, with_error
 from . import runs
 from .drops import K_CAP
 

@@ -25,12 +25,10 @@ Masters (each but container-gs steps every FMU from the last communication point
   reference  the scene's Chain (scenes.chain) solved monolithically by scipy.
 """
 
-import math
-
 import numpy as np
 
 from .. import crash, fmu_path
-from ..ssp import bound_parameters
+from ..ssp import bound_parameters, grid
 from . import bumper as bumper_reference
 from . import headform as headform_reference
 from .chain import Contact
@@ -70,12 +68,6 @@ def scene_arguments(scene, options):
 def values(scene, options=None):
     """{component: {variable: value}} of a run."""
     return VALUES[scene](**scene_arguments(scene, options))
-
-
-def grid(H, t_end):
-    """The communication points 0, H, ..., N H with N H the last <= t_end."""
-    n = int(math.floor(t_end / H * (1 + 1e-12)))
-    return np.arange(n + 1) * H
 
 
 def run(scene, master, H=None, t_end=None, options=None):

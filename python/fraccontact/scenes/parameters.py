@@ -23,7 +23,7 @@ Pedestrian headform on a bonnet
 | panel damping c_p | 300 N s/m | assumed | damping ratio 0.3 with the adult head and panel |
 | hard point k (Hertz) | 1.24e10 N/m^1.5 | derived | k = (4/3) E* sqrt(R): steel panel (210 GPa, 0.3) on an aluminium part (70 GPa, 0.33) of radius 25 mm (assumed) |
 | hard point c | 1e5 N s/m | assumed | stiff: the dashpot yields little at the panel's speed |
-| clearance found needed | about 50 mm child, 70 mm adult | published | BASt bonnet study (quoted by issue 25), the comparison for clearance_for_hic |
+| clearance found needed | about 50 mm child, 70 mm adult | published | BASt bonnet study, the comparison for clearance_for_hic |
 
 Low-speed bumper impact
 
@@ -31,13 +31,13 @@ Low-speed bumper impact
 |---|---|---|---|
 | impact speed | 2.5 mph = 1.1176 m/s | published | 49 CFR 581 (bumper standard) |
 | impact speed | 4 km/h = 1.1111 m/s | published | UN ECE R42 |
-| vehicle body mass M | 1500 kg | assumed | a mid-size car (issue 25: "about 1 500 kg") |
+| vehicle body mass M | 1500 kg | assumed | a mid-size car (about 1 500 kg) |
 | bumper beam + fascia mass m_b | 5 kg | assumed | |
 | crash box stiffness k_box | 1e6 N/m (1 kN/mm) | assumed | elastic at these speeds (49 CFR 581: no damage) |
 | crash box damping c_box | 7.75e3 N s/m | assumed | damping ratio 0.1 of the body on the crash box |
 | fascia k (Hertz) | 2.92e9 N/m^1.5 | derived | k = (4/3) E* sqrt(R): polypropylene (2.64 GPa, 0.4: docs/model.md §1, the paper's h20 fit) against a steel barrier (210 GPa, 0.3), fascia radius of curvature 0.5 m (assumed) |
 | fascia c | 5.19e4 N s/m | derived | restitution 0.59 (the paper's h20, docs/model.md §1) of the beam alone striking the barrier at 2.5 mph with that k |
-| vehicle-to-vehicle restitution | 0.2-0.4 at 2-5 mph | published | Howard, Bomar & Bare, SAE 931842 (quoted by issue 25), the comparison for the bumper's restitution |
+| vehicle-to-vehicle restitution | 0.2-0.4 at 2-5 mph | published | Howard, Bomar & Bare, SAE 931842, the comparison for the bumper's restitution |
 
 Elastic Hertz limit: HIC ~ m^(-3/(2(n+1))) v^((4n+1)/(n+1)), i.e. m^-0.6 v^2.8 at
 n = 3/2 (Hutchinson, J Biomech Eng 135 (2013) 114508).

@@ -1,6 +1,6 @@
 """Benchmarks, measured side by side in one run on this machine:
   1. ns per internal step of each spring law (and of the literal O(N) G1 sum);
-  2. work against precision (issue 14) on one impact to the last bit: our
+  2. work against precision on one impact to the last bit: our
      error-controlled steps, our fixed steps, the GSL rk8pd anchor and
      scipy's solve_ivp (LSODA, DOP853, Radau) over their tolerance or step
      ladders, judged on the largest error of F_peak, eps, t_contact and
@@ -13,7 +13,7 @@
   4. the Python package against the C core: fraccontact.impacts against
      fraccontact-bench batch (CPU per impact), a process per impact,
      fraccontact sweep on 1 and 2 local Dask workers, a 1000-row curve fit;
-  5. the springpot (issue 12): ns per internal step of the dashpot, the
+  5. the springpot: ns per internal step of the dashpot, the
      compressed memory and the full G1 history over the h20 impact; a
      springpot impact by both memories on N = 1e3 .. 1e6 steps of one span
      (the full history's N = 1e6 run, O(N^2), timed once: about 10 minutes),
@@ -49,10 +49,10 @@ from scipy.special import gamma
 
 import differint.differint as differint
 
-from .. import atomic, fit, fmu, model, reports, solver
-from ..scipy_contact import solve_drop
+from fraccontact import atomic, fit, fmu, model, output, solver
+from fraccontact.scipy_contact import solve_drop
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 TARGET = 1e-6
 # Section 4: (label, law, dt_max, impacts in one fraccontact.impacts call,
@@ -70,7 +70,7 @@ CONTROLLED_REFERENCE = 1e-11  # the figures' reference: the same impact at this 
 # the dashpot's tolerances, four a decade, for the springpot's accuracy at the dashpot's cost
 CONTROLLED_LADDER = tuple(float(f"{10 ** (-6 - k / 4):.2g}") for k in range(17))
 CONTROLLED_FIGURES = ("F_peak", "eps", "t_contact", "x2_end", "E_diss")
-CONTROLLED_BAR = 3.0  # issue 26: the springpot's impact at most 3x the dashpot's
+CONTROLLED_BAR = 3.0  # the target: the springpot's impact at most 3x the dashpot's
 # The steps against the springpot's order at the tightest tolerance: c_alpha
 # scaled as the default pair (c 6080, c_alpha 3e5 at alpha 0.5) is, so that
 # the damping at the impact's frequency stays the dashpot's.
@@ -127,7 +127,7 @@ def step_costs(bench):
     return run(bench, "step")
 
 
-# --- 2. work against precision (issue 14) ---------------------------------------
+# --- 2. work against precision ---------------------------------------------------
 #
 # Every method solves the same impact, to the last bit: the parameters are
 # read back from the reference's own run (--height 0.02 makes v = sqrt(2 g h)
@@ -135,7 +135,7 @@ def step_costs(bench):
 # relative error of the case's figures against that reference.
 
 FIGURES = ("F_peak", "eps", "t_contact", "x2_end")
-# The stiff case of issue 14: a soft dashpot, 10 ms of a contact that lasts
+# The stiff case: a soft dashpot, 10 ms of a contact that lasts
 # about 0.3 s, judged on F_peak alone (over 10 ms no impact has ended).
 SOFT = dict(k=3.299e8, c=50.0, m=0.7437, v=3.0, t_end=0.01)
 REFERENCE_RTOL = 1e-14
@@ -162,7 +162,7 @@ LADDER_SECONDS = 2.0  # a ladder stops after a setting costing more per impact: 
 ROUNDS = 7            # head-to-head rounds of the cheapest settings
 FMU_H = 2e-3          # one doStep over the whole h20 contact (1.32 ms)
 # The FMU's settings: label, tolerance, dt_max, one-doStep impacts a round.
-# The issue names tolerance 1e-6; 5e-8 is docs/numerics.md's setting for the four
+# The target names tolerance 1e-6; 5e-8 is docs/numerics.md's setting for the four
 # figures within 1e-6 (a twentieth of the target), so it is measured too.
 FMU_FIXED = "fixed: tolerance 0, dt_max 1e-7 s (the defaults)"
 FMU_SETTINGS = (("adaptive: tolerance 1e-6, dt_max 1e-3 s", 1e-6, 1e-3, 60),
@@ -366,7 +366,7 @@ def plot_precision(path, r):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9)
     fig.suptitle("Work against precision (gray: 1e-6; ringed: the cheapest setting meeting it)")
-    reports.save(fig, path, rect=(0, 0.08, 1, 1))
+    output.save(fig, path, rect=(0, 0.08, 1, 1))
 
 
 def precision(root, program, bench, fmu_file, out):
@@ -427,7 +427,7 @@ def cpu_ratio(methods, slower, faster):
 
 
 def target_line(text, q, bar, aim=None):
-    """A ratio against its target (and the issue's aim, where it names one)."""
+    """A ratio against its target (and the aim beyond it, where there is one)."""
     if q is None:
         return f"- {text}: not measurable (a method never met 1e-6)"
     line = f"- {text}: {q:.2f}x; target >= {bar:g}x: {met(q >= bar)}"
@@ -451,7 +451,7 @@ def precision_section(r):
     ref, ref_soft = r["cases"]["h20"]["reference"], r["cases"]["soft"]["reference"]
     fmu_ = r["fmu"]
     load = r["load"]
-    out = [PRECISION_BEGIN, "## Work against precision on all four figures (issue 14)", "",
+    out = [PRECISION_BEGIN, "## Work against precision on all four figures", "",
            "Regenerate this section alone, in place: `scripts/report benchmarks --only precision` (this run: "
            f"{r['minutes']:.1f} minutes). Measured side by side in one run on commit {r['head']}"
            + (" (with uncommitted changes to fmu_src/, solver/ or CMakeLists.txt in the working tree)"
@@ -493,13 +493,13 @@ def precision_section(r):
            "", f"![work against precision]({PRECISION_FIGURE})", "",
            "### h20: all four figures within 1e-6", ""]
     out += cheapest_table(h20)
-    out += ["", target_line("the anchor's CPU over ours, adaptive (issue 14)", cpu_ratio(h20, ANCHOR, ADAPTIVE), 1.0,
+    out += ["", target_line("the anchor's CPU over ours, adaptive", cpu_ratio(h20, ANCHOR, ADAPTIVE), 1.0,
                             aim=3.0),
-            target_line("LSODA's CPU over ours, adaptive (issue 14)", cpu_ratio(h20, LSODA, ADAPTIVE), 100.0),
+            target_line("LSODA's CPU over ours, adaptive", cpu_ratio(h20, LSODA, ADAPTIVE), 100.0),
             error_over_tolerance(h20),
             "", "### The soft dashpot: F_peak within 1e-6 over 10 ms", ""]
     out += cheapest_table(soft)
-    out += ["", target_line("the anchor's CPU over ours, adaptive (issue 14)", cpu_ratio(soft, ANCHOR, ADAPTIVE), 3.0),
+    out += ["", target_line("the anchor's CPU over ours, adaptive", cpu_ratio(soft, ANCHOR, ADAPTIVE), 3.0),
             target_line("our fixed steps' CPU over ours, adaptive", cpu_ratio(soft, FIXED, ADAPTIVE), 1.0),
             error_over_tolerance(soft),
             "", "### The FMU's own CPU for one impact, in one doStep", "",
@@ -521,11 +521,11 @@ def precision_section(r):
     for label, x in fmu_.items():
         if label != FMU_FIXED:
             out.append(target_line(f"the fixed defaults' CPU over the adaptive one's at tolerance {x['tolerance']:g} "
-                                   "(issue 14 sets the target at 1e-6)", fmu_[FMU_FIXED]["cpu"] / x["cpu"], 10.0))
+                                   "(the target is set at 1e-6)", fmu_[FMU_FIXED]["cpu"] / x["cpu"], 10.0))
     out += ["- F_peak within 1e-6 of the reference after that one doStep: " + "; ".join(
                 f"tolerance {x['tolerance']:g}: {'yes' if x['errors']['F_peak'] <= TARGET else '**no**'} "
                 f"({x['errors']['F_peak']:.1e})" for x in fmu_.values())
-            + ". (The issue's accuracy target for the FMU is at a 1e-5 s communication step, tested in "
+            + ". (The FMU's accuracy target is at a 1e-5 s communication step, tested in "
             "tests/test_tolerance.py; in one doStep over the impact the steps are the ones the tolerance alone "
             "chooses, as in the solver's runs above.)",
             "", "### Every setting: h20", ""]
@@ -958,7 +958,7 @@ def springpot_section(r):
         out.append(f"| {label} | {x['steps']:,} | {x['ns_per_step']:,.1f} | "
                    f"{x['ns_per_step'] / dash['ns_per_step']:,.2f}x | {x['repeats']} | {x['memory_values']:,} | "
                    f"{s['1e4']:,} B | {s['after']:,} B |")
-    paragraph = (f"The issue's bar, a compressed step at most 5x the dashpot's: "
+    paragraph = (f"The bar, a compressed step at most 5x the dashpot's: "
                  f"{'**met**' if bar <= 5 else '**not met**'} ({bar:.2f}x). "
                  f"The compressed memory's FMU state keeps its size: {st['compressed']['start']:,} B at t = 0, "
                  f"{st['compressed']['1e4']:,} B after 1e4 steps, {r['resting']['end']:,} B after "
@@ -1068,7 +1068,7 @@ def seconds(x):
 
 # --- the report ---------------------------------------------------------------
 
-# --- 6. the springpot under error control (issue 26) ---------------------------
+# --- 6. the springpot under error control --------------------------------------
 
 def controlled_rows(bench):
     """fraccontact-bench controlled at each tolerance (the dashpot and the
@@ -1156,7 +1156,7 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
                    / (r["dashpot"]["seconds_per_impact"] / r["dashpot"]["steps"]) for r in rows]
     order = {name: math.log(errors[name][0] / errors[name][-1]) / math.log(counts[name][-1] / counts[name][0])
              for name in errors}
-    out += ["", f"The issue's bar, the springpot's impact at most {CONTROLLED_BAR:g}x the dashpot's at both "
+    out += ["", f"The bar, the springpot's impact at most {CONTROLLED_BAR:g}x the dashpot's at both "
             f"tolerances: **{'met' if met else 'not met'}** ({', '.join(f'{q:.2f}x' for q in ratios)}). "
             f"The springpot takes {span(counts['springpot'][0] / counts['dashpot'][0], counts['springpot'][-1] / counts['dashpot'][-1])} "
             f"times the dashpot's steps, and each costs {span(*step_ratios)} "
@@ -1189,13 +1189,13 @@ def controlled_section(rows, ladder, reference, by_order, by_kernel, default_ste
     return out
 
 
-# --- instruction counts (issue 35) -------------------------------------------
+# --- instruction counts ------------------------------------------------------
 
 INSTRUCTIONS_BEGIN, INSTRUCTIONS_END = "<!-- instruction counts: begin -->", "<!-- instruction counts: end -->"
-# Issue 35's table: the dashpot's paths before the four issues that slowed
-# them (b022927) and where the issue found them (26f430c), each built anew.
+# The regression table: the dashpot's paths before the four changes that
+# slowed them (b022927) and where they were found slowed (26f430c), each built anew.
 INSTRUCTIONS_BEFORE, INSTRUCTIONS_FOUND = "b022927", "26f430c"
-INSTRUCTIONS_ISSUE_ROWS = (("law 1, fixed steps, per step", "law1_fixed"),
+INSTRUCTIONS_REGRESSION_ROWS = (("law 1, fixed steps, per step", "law1_fixed"),
                            ("law 2, fixed steps, per step", "law2_fixed"),
                            ("law 2, `--tolerance 1e-7 --dt-max 1e-3`, per impact", "dashpot_controlled_1e-7"))
 
@@ -1210,8 +1210,8 @@ def instruction_counter(root):
 
 
 def instruction_rows(root, program, fmu_file):
-    """Every row of the record counted on this build, and the issue's rows
-    on the two commits it compares."""
+    """Every row of the record counted on this build, and the regression table's
+    rows on the two commits it compares."""
     counter = instruction_counter(root)
     toolchain, record = counter.read_record()
     build = pathlib.Path(program).parent
@@ -1225,7 +1225,7 @@ def instruction_rows(root, program, fmu_file):
         say(f"  building {commit} in a temporary git worktree ...")
         with base_build(root, commit, ("fraccontact-solve",)) as base:
             then[commit] = {name: counter.measure(by_name[name], {"fraccontact-solve": base["solve"]})
-                            for _, name in INSTRUCTIONS_ISSUE_ROWS}
+                            for _, name in INSTRUCTIONS_REGRESSION_ROWS}
     compiler = [line.split("=", 1)[1] for line in (build / "CMakeCache.txt").read_text().splitlines()
                 if line.startswith("CMAKE_C_COMPILER:")][0]
     return dict(here=here, then=then, toolchain=counter.toolchain_of(compiler), recorded=toolchain,
@@ -1239,7 +1239,7 @@ def instruction_count(value):
 def instructions_section(r):
     before, found = (r["then"][c] for c in (INSTRUCTIONS_BEFORE, INSTRUCTIONS_FOUND))
     here = {row["name"]: row for row in r["here"]}
-    out = [INSTRUCTIONS_BEGIN, "## Instruction counts (issue 35)", "",
+    out = [INSTRUCTIONS_BEGIN, "## Instruction counts", "",
            "Regenerate this section alone, in place: `scripts/report benchmarks --only instructions` (under a "
            f"minute: it builds {INSTRUCTIONS_BEFORE} and {INSTRUCTIONS_FOUND} in temporary git worktrees). "
            "Instructions counted by valgrind's callgrind as the difference of two repeat counts, so that start-up "
@@ -1248,11 +1248,11 @@ def instructions_section(r):
            + ("." if r["toolchain"] == r["recorded"] else f" (the record's: {r['recorded']})."), "",
            f"| run | {INSTRUCTIONS_BEFORE} | {INSTRUCTIONS_FOUND} | this commit | this / {INSTRUCTIONS_BEFORE} |",
            "|---|---|---|---|---|"]
-    for label, name in INSTRUCTIONS_ISSUE_ROWS:
+    for label, name in INSTRUCTIONS_REGRESSION_ROWS:
         v = here[name]["value"]
         out.append(f"| {label} | {instruction_count(before[name])} | {instruction_count(found[name])} | "
                    f"{instruction_count(v)} | {v / before[name]:.3f} |")
-    worst = max(here[name]["value"] / before[name] for _, name in INSTRUCTIONS_ISSUE_ROWS)
+    worst = max(here[name]["value"] / before[name] for _, name in INSTRUCTIONS_REGRESSION_ROWS)
     out += ["", f"Every row at or below {INSTRUCTIONS_BEFORE}'s: **{'yes' if worst <= 1.0 else 'no'}** "
             f"(at most {worst:.3f} of it).", "",
             "The guard: `ctest -R instruction_counts` (in the normal build, where valgrind is installed; not in the "
@@ -1278,7 +1278,7 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
            "CPU time, medians of repeated runs. On this shared virtual machine the same binary's timings move by "
            "up to 30 % from one run to the next; the ratios within one run are steadier.", "",
            *kept_section(path, SWEEP_BEGIN, SWEEP_END, [
-               "The sweep at scale (issue 26: `fraccontact sweep` end to end against the C core, one worker and "
+               "The sweep at scale (`fraccontact sweep` end to end against the C core, one worker and "
                "two, the serial fraction, the client's memory): [sweep_scaling.md](sweep_scaling.md), regenerated "
                "by `scripts/report sweep_scaling`."]), "",
            "## Cost of an internal step", "",
@@ -1300,7 +1300,7 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
             "N intervals of [0, 1]. Newest point: `g1_history_sum` (weights included) against "
             "`differint.GLpoint`; full grid: `g1_full_grid` (zero-padded FFT, the first N/128 points summed "
             "directly) against `differint.GL`. Errors are the largest over every grid point, relative to the "
-            "closed-form G1 value there (computed independently in fraccontact/reports/benchmarks.py).", "",
+            "closed-form G1 value there (computed independently in reports/benchmarks.py).", "",
             "| N | ours, newest point | differint GLpoint | ratio | ours, full grid | differint GL | ratio | "
             "our worst error | differint GL worst error | differint GL points off by > 1e-9 | "
             "differint GLpoint error |", "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -1323,22 +1323,22 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
-    reports.add_fmu(parser)
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
+    output.add_fmu(parser)
     parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions"],
                         help="regenerate one section alone, in place (precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
                              "core; springpot: the springpot's memories, and the dashpot against the commit before "
                              "them; controlled: the springpot against the dashpot under error control; "
-                             "instructions: the instruction counts of the guard's runs, and issue 35's table)")
+                             "instructions: the instruction counts of the guard's runs, and the regression table)")
     parser.add_argument("--largest-n", type=float, default=1e6,
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     program, bench = args.solver, solver.bench_path(args.solver)
     if args.only == "precision":
         say("work against precision ...")
-        section = precision(reports.source_tree(), program, bench, args.fmu, args.out)
+        section = precision(source_tree(), program, bench, args.fmu, args.out)
         replace_section(args.out / "benchmarks.md", section, PRECISION_BEGIN, PRECISION_END)
         print((args.out / "benchmarks.md").read_text())
         return
@@ -1349,7 +1349,7 @@ def main(argv=None, prog=None):
         return
     if args.only == "springpot":
         say("the springpot ...")
-        section = springpot_section(springpot_rows(reports.source_tree(), bench, args.fmu, args.largest_n))
+        section = springpot_section(springpot_rows(source_tree(), bench, args.fmu, args.largest_n))
         replace_section(args.out / "benchmarks.md", section, SPRINGPOT_BEGIN, SPRINGPOT_END)
         print((args.out / "benchmarks.md").read_text())
         return
@@ -1361,11 +1361,11 @@ def main(argv=None, prog=None):
         return
     if args.only == "instructions":
         say("instruction counts ...")
-        section = instructions_section(instruction_rows(reports.source_tree(), program, args.fmu))
+        section = instructions_section(instruction_rows(source_tree(), program, args.fmu))
         replace_section(args.out / "benchmarks.md", section, INSTRUCTIONS_BEGIN, INSTRUCTIONS_END)
         print((args.out / "benchmarks.md").read_text())
         return
-    root = reports.source_tree()
+    root = source_tree()
     say("1/5 cost of a step ...")
     steps = step_costs(bench)
     say("2/5 work against precision ...")

@@ -18,13 +18,14 @@ import sys
 import numpy as np
 from tqdm import tqdm
 
-from .. import atomic, hertz, impact, model, reports
-from . import BAR
-from ..cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,
-                     fmu_paths, monolithic, spring_reference)
-from ..ssp import run_fmpy, run_libcosim, ssp_path
+from fraccontact import atomic, hertz, impact, model, output
+from fraccontact.cosim import (COUPLINGS, M, ORDERS, V0, add_fmu_options, cosimulate, cosimulate_libcosim,
+                               fmu_paths, monolithic, spring_reference)
+from fraccontact.ssp import run_fmpy, run_libcosim, ssp_path
 
-plt = reports.pyplot()
+from . import BAR
+
+plt = output.pyplot()
 
 STEPS = [float(f"{h:.3g}") for h in np.logspace(-6, -3, 31)]
 DECADES = (1e-6, 1e-5, 1e-4, 1e-3)
@@ -108,11 +109,11 @@ def errors(r, ref, H):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
+    parser = output.parser(prog, __doc__)
     add_fmu_options(parser)
     parser.add_argument("--ssp", type=pathlib.Path,
                         help="the scene as SSP (default: $DROP_TEST_SSP, else drop_test.ssp beside the contact FMU)")
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     contact, striker = fmu_paths(parser, args)
     try:
         ssp = args.ssp or ssp_path()
@@ -193,7 +194,7 @@ def plot(path, results, forced, traces):
         ax.grid(alpha=0.3, which="both")
     axes.flat[4].legend(fontsize=8)
     fig.suptitle("Striker FMU + contact FMU against the monolithic drop test (h20)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def ssp_runs(ssp, contact, striker):
@@ -283,7 +284,7 @@ def write(path, results, forced, ref, ref_g, scene, g1, spring):
         a, b = at(ours, H), at(theirs, H)
         out.append(f"| {H:g} | {a['F_peak_error']:.1e} | {a['eps_error']:.1e} | {a['energy_error']:.2e} | "
                    f"{b['F_peak_error']:.1e} | {b['eps_error']:.1e} | {b['energy_error']:.2e} |")
-    out += ["", f"- **Exact at every step**: the issue's target is 1e-3 in F_peak and eps at H = 1e-4 s; the "
+    out += ["", f"- **Exact at every step**: the target is 1e-3 in F_peak and eps at H = 1e-4 s; the "
             f"coupling meets it at every H of the ladder up to 1e-3 s, where the impact spans two steps, with "
             f"errors of {worst(ours)} (our driver) and {worst(theirs)} (libcosim): rounding where H is a multiple of "
             "dt_max, and the scheme's O(dt^2) difference of internal steps elsewhere (the contact splits H into "

@@ -8,7 +8,8 @@ import dataclasses
 import functools
 import math
 
-from ... import hertz, model, solver
+from fraccontact import hertz, model, solver
+
 from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 
 # The paper's h20 test; a case changes some of these (v0 is the library's v, dt its dt_max).
@@ -66,7 +67,7 @@ _FORCE_CASES = ["corner c 0.01, E_s 1e+06, v0 0.0001, m 0.001, dt 0.01",
                 "corner c 0.01, E_s 2.1e+11, v0 30, m 1000, dt 0.01"]
 KNOWN = {**{run: {ENERGY} for run in _ENERGY_RUNS}, **{run: {ENERGY, EPS} for run in _ENERGY_EPS_RUNS},
          **{(case, law): {FORCE} for case in _FORCE_CASES for law in ("g1", "hertz")}}
-# The adaptive variant (issue 14): law 2 (Hertz) with tolerance = 1e-6 and
+# The adaptive variant: law 2 (Hertz) with tolerance = 1e-6 and
 # the case's dt as the cap dt_max. No run of it fails a check
 # (docs/stability.md, "Adaptive steps"), so KNOWN lists none: a failure
 # there is new.

@@ -45,7 +45,8 @@ import tempfile
 import threading
 import time
 
-from .. import atomic
+from fraccontact import atomic
+
 from . import source_tree
 
 ROOT = source_tree()
@@ -549,7 +550,7 @@ def section(results, started, seconds, jobs, source, left_out):
     errors = [r.mutant.name for r in results if r.verdict == "ERROR"]
     lines = [BEGIN, "## Mutation testing", "",
              "Regenerate: `scripts/report mutation` (this section only; `--list` shows the mutants, "
-             "`--only NAME...` re-runs some without writing here). `python/fraccontact/reports/mutation.py` copies the working tree "
+             "`--only NAME...` re-runs some without writing here). `reports/mutation.py` copies the working tree "
              "(tracked and untracked files) to a scratch directory, applies each mutant there (each edit's original "
              "text must occur exactly once in its file, or the run stops: the source moved), rebuilds, and runs the "
              "C tests (ctest, stopping at the first failure) and then `pytest -x` (files in alphabetical order, "

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from .. import atomic, fit, model, reports, sweep
+from fraccontact import atomic, fit, model, output, sweep
 
 # The paper's h20 row (docs/model.md §1, Table 1): what was measured, and the
 # constants the paper fitted, which are the library's defaults.
@@ -44,7 +44,7 @@ def throughput(out, workers, n):
 
 
 def plot(path, paper_rows, fitted_rows):
-    plt = reports.pyplot()
+    plt = output.pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
     spec = [("F_peak", 1, "peak force F_peak [N]"), ("eps", 1, "restitution coefficient eps"),
             ("t_contact", 1e3, "contact time [ms]"), ("x2_end", 1e6, "permanent indentation [um]")]
@@ -59,10 +59,10 @@ def plot(path, paper_rows, fitted_rows):
         ax.grid(alpha=0.3)
     axes.flat[0].legend(fontsize=8)
     fig.suptitle(f"Drop-height sweep, 5 to 100 mm (m = {PAPER['m']:g} kg, Hertz law)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
-# The springpot (issue 12, item 7): the h20 row cannot identify k, c_alpha and alpha.
+# The springpot: the h20 row cannot identify k, c_alpha and alpha.
 
 SHOWN = (1.0, 0.8, 0.6, 0.45, 0.35, 0.3)   # the family's members drawn and tabled in full
 TRUTH_ALPHA = 0.6                         # the member whose data the identifiability section fits
@@ -161,7 +161,7 @@ def family_section(out):
         E_s = modulus(mb["k"])
         pr = by_alpha.get(mb["alpha"])
         lines.append(f"| {mb['alpha']:.2f} | {mb['k']:.4g} | {mb['c_alpha']:.4g} | "
-                     f"{'none' if E_s is None else reports.significant(E_s / 1e9, 3)} | {pr['t_contact'] * 1e3:.4f} | "
+                     f"{'none' if E_s is None else output.significant(E_s / 1e9, 3)} | {pr['t_contact'] * 1e3:.4f} | "
                      f"{pr['x2_end'] * 1e6:.2f} | {pr['F'][0]:.1f} | {pr['F'][-1]:.1f} | {pr['eps'][0]:.4f} | "
                      f"{pr['eps'][-1]:.4f} |")
     lines += ["", f"Below alpha = {members[-1]['alpha']:.2f} the table ends: the family's k rises without bound as "
@@ -209,7 +209,7 @@ def family_section(out):
 
 
 def plot_family(path, members, predictions, alpha_min, alpha_E, heights):
-    plt = reports.pyplot()
+    plt = output.pyplot()
     import matplotlib.ticker
     fig, axes = plt.subplots(2, 2, figsize=(11, 8))
     ax = axes[0, 0]
@@ -239,7 +239,7 @@ def plot_family(path, members, predictions, alpha_min, alpha_E, heights):
     axes[1, 1].legend(fontsize=7)
     for ax in axes.flat:
         ax.grid(alpha=0.3)
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def synthetic_drops(params, heights, repeats, noise_F, noise_eps, seed, sigmas=False):
@@ -305,10 +305,10 @@ def identifiability_section(base, truth_member):
         cells = []
         for name in ("k", "c_alpha", "alpha"):
             if "exact" in label:     # no noise: the standard errors measure the model's 1e-6, show the deviation
-                cells.append(f"{reports.significant(r[name], 6)} (relative error {r[name] / truth[name] - 1:+.1e})")
+                cells.append(f"{output.significant(r[name], 6)} (relative error {r[name] / truth[name] - 1:+.1e})")
                 continue
             sigma = r[f"sigma_{name}"]
-            cells.append(f"{reports.with_error(r[name], sigma, '')} ({(r[name] - truth[name]) / sigma:+.1f})")
+            cells.append(f"{output.with_error(r[name], sigma, '')} ({(r[name] - truth[name]) / sigma:+.1f})")
         lines.append(f"| {label} | identified | " + " | ".join(cells) + f" | {r['condition']:.3g} | {seconds:.1f} s |")
     lines += ["", "One drop test's two numbers cannot identify three parameters, and repeating the test adds "
               "scatter, not a direction (the Jacobian keeps rank 2). A second height does, through the peak force's "
@@ -321,10 +321,10 @@ def identifiability_section(base, truth_member):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
+    parser = output.parser(prog, __doc__)
     parser.add_argument("--impacts", type=int, default=4000, help="impacts for the throughput runs (default 4000)")
-    args = reports.parse(parser, argv)
-    reports.pyplot()  # before the minutes of sweeps: a missing matplotlib is said at once
+    args = output.parse(parser, argv)
+    output.pyplot()  # before the minutes of sweeps: a missing matplotlib is said at once
     with tempfile.TemporaryDirectory() as work:
         write_report(args, pathlib.Path(work))
 

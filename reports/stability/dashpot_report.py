@@ -173,7 +173,7 @@ def section(study, rows):
         out += ["## Failures", "",
                 "Every failure below fails a check that holds in the model at any step; none is widened to "
                 "pass. Those marked *known finding* are two properties of the time scheme (fmu_src/model/sdirk2.c), "
-                "listed in `KNOWN` in fraccontact/reports/stability/dashpot.py so that a fix, or a new failure, "
+                "listed in `KNOWN` in reports/stability/dashpot.py so that a fix, or a new failure, "
                 "stops the script:", ""]
         out += [f"- **{c}**: {FINDINGS[c]}" for c in FINDINGS] + [""]
         for n, r in failed:

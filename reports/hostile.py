@@ -38,7 +38,8 @@ import sys
 
 from tqdm import tqdm
 
-from .. import atomic, hertz, model, reports, solver
+from fraccontact import atomic, hertz, model, output, solver
+
 from . import BAR
 
 REALS = ["v", "m", "R", "E_i", "nu_i", "E_s", "nu_s", "k", "c", "dt_max", "g", "gap0"]
@@ -237,7 +238,7 @@ CHILD = r'''
 import json, sys
 from fmpy import extract, read_model_description
 from fraccontact.fmu import Slave
-from fraccontact.reports.hostile import run_case_in
+from reports.hostile import run_case_in
 md = read_model_description(sys.argv[1])
 print(json.dumps(run_case_in(Slave(md, extract(sys.argv[1]), start=False), json.loads(sys.argv[2]))))
 '''
@@ -671,10 +672,10 @@ CHECKS = {"reference": check_reference, "constant rate": check_constant_rate, "r
 # --- the report ---------------------------------------------------------------
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_fmu(parser)
-    reports.add_solver(parser, "fraccontact-solve, for its --reference")
-    args = reports.parse(parser, argv)
+    parser = output.parser(prog, __doc__)
+    output.add_fmu(parser)
+    output.add_solver(parser, "fraccontact-solve, for its --reference")
+    args = output.parse(parser, argv)
     all_cases = list(cases())
     rows = []
     with tqdm(all_cases, file=sys.stderr, disable=None, bar_format=BAR) as bar:
@@ -688,7 +689,7 @@ def main(argv=None, prog=None):
         expected[verdict_of(c)] = expected.get(verdict_of(c), 0) + 1
         observed[r["observed"]] = observed.get(r["observed"], 0) + 1
     out = ["# Hostile and degenerate input", "",
-           "Regenerate: `scripts/report hostile` (`fraccontact/reports/hostile.py`; pytest runs the same cases and "
+           "Regenerate: `scripts/report hostile` (`reports/hostile.py`; pytest runs the same cases and "
            "checks, "
            "`tests/test_hostile.py`). Each case runs through fmpy in a process of its own, over 2 ms of the h20 "
            "drop test unless stated, and states the verdict it must reach:", "",

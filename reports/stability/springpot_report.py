@@ -36,7 +36,7 @@ ORDER_FINDING = (
     "t_contact's -0.1 to -0.4, the same at a kernel tolerance of 1e-10, and F_peak converges at the order 1.1 "
     "(successive differences 7.8e-5, 3.5e-5, 1.6e-5, 7.4e-6, 3.4e-6, 1.6e-6 N from dt = t_c/4096 to "
     "t_c/262144); at alpha = 0.99 E_diss errs by 0.3 lambda. At the default dt_max = 1e-7 it is 1.3e-7 "
-    "relative, far below the issue's 1e-4; a dashpot lumped with the first moment kept (or the rates kept "
+    "relative, far below the target of 1e-4; a dashpot lumped with the first moment kept (or the rates kept "
     "to 1/dt_max^(2/(2 - alpha))) would restore the second order. The matrix's tolerance for memory 2 "
     "carries lambda, computed from the kernel the library reports (springpot.lumped_moment); the study "
     "measures its coefficient.")

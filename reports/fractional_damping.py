@@ -1,4 +1,4 @@
-"""Fractional damping (issue 12, item 8): the springpot F = c_alpha D^alpha x2
+"""Fractional damping: the springpot F = c_alpha D^alpha x2
 against the dashpot on the paper's drop test. Force curves and hysteresis
 loops for alpha from 0.1 to 1; restitution and peak force against drop height
 (5 to 100 mm); the dent's recovery after separation and the second contact
@@ -19,10 +19,10 @@ import numpy as np
 
 import matplotlib.ticker
 
-from .. import atomic, model, reports, solver
-from ..fmu import Slave, unpacked
+from fraccontact import atomic, model, output, solver
+from fraccontact.fmu import Slave, unpacked
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 H20 = model.defaults()
 M, V0, C = H20["m"], H20["v"], H20["c"]
@@ -422,7 +422,7 @@ def memory_agreement():
 
 def ladder():
     """Section 5c: both memories over dt_max. The default spring (law 1, the
-    G1 law) for the issue's criterion; the closed-form Hertz spring (law 2)
+    G1 law) for the accuracy criterion; the closed-form Hertz spring (law 2)
     and tolerance 1e-12 to see each memory's own time-stepping error, against
     the compressed memory at its finest step (1.6e-9 s, ~900 000 steps)."""
     default = {dt: dict(full=model.impact(damper=2, memory=1, dt_max=dt),
@@ -468,7 +468,7 @@ def plot_curves(path, series, omega):
     ax_t.legend(fontsize=8)
     fig.suptitle(f"h20 drop test with a springpot, c_alpha = c omega^(1-alpha), c = {C:g} N s/m, "
                  f"omega = {omega:.0f} rad/s")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_heights(path, h):
@@ -493,7 +493,7 @@ def plot_heights(path, h):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.suptitle(f"Drop heights 5 to 100 mm (m = {M:g} kg, k = {H20['k']:.4g} N/m^1.5, n = 1.5)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_recovery(path, rec, sc):
@@ -529,7 +529,7 @@ def plot_recovery(path, rec, sc):
              title="Second contact under gravity: it begins where x = x2")
     ax_s.grid(alpha=0.3)
     ax_s.legend(fontsize=8)
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_cost(path, rows, sizes, bench_json):
@@ -559,7 +559,7 @@ def plot_cost(path, rows, sizes, bench_json):
     for ax in (ax_c, ax_s):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def plot_memory(path, k, agree, lad):
@@ -596,7 +596,7 @@ def plot_memory(path, k, agree, lad):
     for ax in (ax_m, ax_a, ax_l):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, loc="upper left" if ax is ax_l else "best")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 # ------------------------------------------------------------ the report
@@ -642,10 +642,10 @@ def section_curves(series, omega, one):
               "conservative. With the closed-form Hertz spring (law 2) the balance holds to "
               f"{e(abs(hertz[0]), 1)} (dashpot) and {e(abs(hertz[1]), 1)} (springpot 0.5). The springpot at alpha = 1 "
               f"(c_1 = c) against the dashpot, every internal step ({one['rows'][0]} and {one['rows'][1]} rows): "
-              + ("identical, bit for bit (the issue asks for 1e-9 relative)."
+              + ("identical, bit for bit (the target is 1e-9 relative)."
                  if one["dF"] == one["F_peak"] == one["eps"] == 0 else
                  f"the largest force difference is {e(one['dF'])} of F_peak, F_peak differs by {e(one['F_peak'])}, "
-                 f"eps by {e(one['eps'])} (relative; the issue asks for 1e-9)."), ""]
+                 f"eps by {e(one['eps'])} (relative; the target is 1e-9)."), ""]
     return lines
 
 
@@ -808,9 +808,9 @@ def bench_lines(bench_json):
     ladder = bench_json["ladder"]
     growth = log_slope([r["N"] for r in ladder], [r["full"]["seconds"] / r["compressed"]["seconds"] for r in ladder])
     lines += ["", f"At h20 the compressed memory's step costs {c['ns_per_step'] / d['ns_per_step']:.2f} times the "
-              "dashpot's (the issue asks for at most 5) and the full history's "
+              "dashpot's (the target is at most 5) and the full history's "
               f"{f['ns_per_step'] / c['ns_per_step']:.0f} times the compressed one's. The speed-up of the "
-              f"compressed memory per impact grows as N^{growth:.2f} (like N, as the issue expects). The "
+              f"compressed memory per impact grows as N^{growth:.2f} (like N, as expected). The "
               "compressed memory steps less often than N over the span: after separation it takes growing "
               "recovery steps (section 3) where the full history keeps stepping dt_max. "
               "`docs/benchmarks.md` carries the same subcommand's ladder to 1e6.", ""]
@@ -908,7 +908,7 @@ def section_memory(k, agree, lad):
               "delta/T = 1e-10) needs 58."]
     d = lad["default"]
     lines += ["", "### Against the full history over the step", "",
-              "The issue's criterion, at the defaults (alpha 0.5, c_alpha 3e5, G1 spring law 1, tolerance 1e-6):", "",
+              "The accuracy criterion, at the defaults (alpha 0.5, c_alpha 3e5, G1 spring law 1, tolerance 1e-6):", "",
               "| dt_max [s] | steps | F_peak, memory 1 [N] | F_peak, memory 2 [N] | relative difference | "
               "eps, memory 1 | eps, memory 2 | relative difference |", "|---|---|---|---|---|---|---|---|"]
     diffs = []
@@ -1004,7 +1004,7 @@ def write_report(args):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_fmu(parser)
-    args = reports.parse(parser, argv)
+    parser = output.parser(prog, __doc__)
+    output.add_fmu(parser)
+    args = output.parse(parser, argv)
     write_report(args)

@@ -18,10 +18,10 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from .. import atomic, model, reports, solver
-from ..scipy_contact import solve_drop
+from fraccontact import atomic, model, output, solver
+from fraccontact.scipy_contact import solve_drop
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 H20 = model.defaults()
 K, C, M, V0 = H20["k"], H20["c"], H20["m"], H20["v"]
@@ -40,13 +40,13 @@ METHODS = [  # label, solver options
 ]
 SCIPY = ("LSODA", "DOP853", "Radau")
 TOLERANCES = [10.0 ** -e for e in range(3, 13)]
-# Error-controlled steps (issue 14): the tolerance chooses the steps, dt_max
+# Error-controlled steps: the tolerance chooses the steps, dt_max
 # only caps them, so it is set far above the contact's 1.3 ms.
 ADAPTIVE = "Hertz (law 2), error-controlled ESDIRK 5(4)"
 ADAPTIVE_OPTIONS = ["--law", "hertz"]
 ADAPTIVE_TOLERANCES = [10.0 ** -e for e in range(3, 11)]
 ADAPTIVE_DT_MAX = 1e-3
-FIGURES = METRICS[:4]  # the impact's four figures, the issue's judgement
+FIGURES = METRICS[:4]  # the impact's four figures, all judged
 
 
 
@@ -109,9 +109,9 @@ def observed_order(dts, errs):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser)
-    args = reports.parse(parser, argv)
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser)
+    args = output.parse(parser, argv)
     tmp = pathlib.Path(tempfile.mkdtemp())
 
     ref = run(args.solver, "--reference", "--law", "hertz", "--csv", tmp / "ref.csv", "--output-interval", GRID)
@@ -185,7 +185,7 @@ def plot(path, results, adaptive_rows, scipy_rows, gsl_rows):
     axes.flat[-1].legend(handles, labels, loc="center", fontsize=9)
     fig.suptitle("Error against CPU time, h20 drop test (fixed internal steps 1e-5 s ... 1.2e-9 s; "
                  "gray line: 1e-6)")
-    reports.save(fig, path)
+    output.save(fig, path)
 
 
 def fmt(x):
@@ -242,7 +242,7 @@ def write_report(path, results, adaptive_rows, scipy_rows, gsl_rows, ref):
            "The G1 laws are compared with the Hertz reference, the physics they approximate: with N fixed the "
            "G1 error 3/(8N) does not shrink with the step and the error stalls there; with N = steps since onset "
            "it shrinks at first order; Richardson extrapolation (law 3) makes it second order at the same cost.",
-           "", f"Error-controlled steps (issue 14: `--law 2 --tolerance T --dt-max {ADAPTIVE_DT_MAX:g}`, Kvaerno's "
+           "", f"Error-controlled steps (`--law 2 --tolerance T --dt-max {ADAPTIVE_DT_MAX:g}`, Kvaerno's "
            "L-stable ESDIRK 5(4) with its embedded error estimate, the Hertz law) at T = 1e-3 ... 1e-10: the "
            "tolerance chooses the steps and `dt_max` only caps them, so they are not in the tables by step; "
            "their force curve is the model advanced from a step's start to each 10 us grid point, as the "
@@ -261,7 +261,7 @@ def write_report(path, results, adaptive_rows, scipy_rows, gsl_rows, ref):
         out.append(f"| {label} | " + " | ".join(
             f"{observed_order([r['dt'] for r in rows], [r[m] for r in rows]):.2f}" for m in METRICS) + " |")
     out += ["", "## Cheapest run with F_peak within 1e-6", "",
-            "The issue's criterion is the peak force alone; some runs meet it by a lucky cancellation while "
+            "This criterion is the peak force alone; some runs meet it by a lucky cancellation while "
             "their eps is far off, so the last column says whether all of F_peak, eps, t_contact and x2_end "
             "are within 1e-6 too.", "",
             "| method | setting | CPU per impact | F_peak error | eps error | all four within 1e-6 |",
@@ -292,7 +292,7 @@ def write_report(path, results, adaptive_rows, scipy_rows, gsl_rows, ref):
         out.append(f"| {label} | {setting} | {cpu * 1e6:.1f} us | {fmt(best['F_peak'])} | {fmt(best['eps'])} | "
                    f"{'yes' if all_four else 'no'} |")
     out += ["", "## Cheapest run with all four figures within 1e-6", "",
-            "The issue's judgement (issue 14): F_peak, eps, t_contact and x2_end all within 1e-6 of the "
+            "The accuracy target: F_peak, eps, t_contact and x2_end all within 1e-6 of the "
             "reference. Per method the coarsest setting of its ladder from which on every finer one meets it "
             "(a coarser run meeting it by a lucky cancellation does not count; the fixed-step ladders are "
             "dt = 1e-5 s / 2^i). docs/benchmarks.md times the fastest of these head to head with the GSL rk8pd "

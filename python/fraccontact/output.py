@@ -1,6 +1,5 @@
-"""The reports under docs/, one module each with main(argv, prog):
-fraccontact report NAME (scripts/report NAME from the source tree). Here,
-what they share (fraccontact fit's output too): the command line, and how
+"""What the commands' outputs share (fraccontact run's and fit's, and the
+reports' under reports/): the command line (--out, --solver, --fmu), and how
 numbers are written and figures drawn."""
 
 import argparse
@@ -8,20 +7,8 @@ import math
 import os
 import pathlib
 
-from .. import atomic, fmu_path, solver
-from ..options import OneLineParser
-
-BAR = "{l_bar}{bar}| {n}/{total}"  # the reports' progress bars: what is being done, the bar, the count
-
-
-def source_tree():
-    """The repository a source-tree report works in (mutation, reliability:
-    they build and test copies of it): the current folder, which
-    scripts/report makes the repository's root."""
-    root = pathlib.Path.cwd()
-    if not (root / "CMakeLists.txt").exists() or not (root / "fmu_src").is_dir():
-        raise SystemExit(f"{root} is not the fraccontact repository: run this report from its root (scripts/report does)")
-    return root
+from . import atomic, fmu_path, solver
+from .options import OneLineParser
 
 
 def parser(prog, doc, out_help="folder of the report (default: docs/)"):

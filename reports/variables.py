@@ -7,8 +7,8 @@ against it, and this page against its rendering."""
 
 import pathlib
 
-from . import parse, parser
-from .. import atomic
+from fraccontact import atomic
+from fraccontact.output import parse, parser
 
 BEGIN, END = "<!-- variables:begin -->", "<!-- variables:end -->"
 COLUMNS = ("name", "kind", "type", "unit", "default", "rule", "vr", "where", "description")

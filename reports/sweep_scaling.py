@@ -1,4 +1,4 @@
-"""The sweep at scale (issue 26): `fraccontact sweep` against the C core on
+"""The sweep at scale: `fraccontact sweep` against the C core on
 the same cases, at the error-controlled setting of a calibration campaign
 (law 2, tolerance 3e-8, dt_max 1e-3; k and c scattered 5 % and 10 %):
   - one worker, end to end (from the command's first statement, Python's own
@@ -17,7 +17,7 @@ the same cases, at the error-controlled setting of a calibration campaign
     workers, threads and processes, and on 4 workers of a `dask scheduler`
     + `dask worker` started as processes.
 The sweeps run as processes, interleaved with the C core's timing, REPEATS
-times; medians. Writes docs/sweep_scaling.md, and the issue's targets in
+times; medians. Writes docs/sweep_scaling.md, and the sweep's targets in
 their section of docs/benchmarks.md.
 
 Regenerate: scripts/report sweep_scaling   (about 5 minutes on 2 cores)
@@ -35,8 +35,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .. import _lib, atomic, reports
-from ..sweep import cases, options, tasks
+from fraccontact import _lib, atomic, output
+from fraccontact.sweep import cases, options, tasks
+
 from .benchmarks import SWEEP_BEGIN, SWEEP_END, LoadWatch, git, replace_section, say
 
 SETTING = ["--scatter", "k=0.05", "--scatter", "c=10%", "--set", "law=2", "--set", "tolerance=3e-8",
@@ -337,9 +338,9 @@ def lines(runs, f, load, head, minutes):
 
 
 def benchmark_section(f, load, head):
-    """The issue's targets for docs/benchmarks.md, from the same figures."""
+    """The sweep's targets for docs/benchmarks.md, from the same figures."""
     return [
-        SWEEP_BEGIN, "## The sweep at scale (issue 26)", "",
+        SWEEP_BEGIN, "## The sweep at scale", "",
         f"From [sweep_scaling.md](sweep_scaling.md) (`scripts/report sweep_scaling`, commit {head}, "
         f"{os.cpu_count()} cores shared with other work: {load_text(load)}): `fraccontact sweep --monte-carlo N "
         + " ".join(SETTING) + "`, end to end (Python's own start excluded), against the C core's single-thread "
@@ -361,7 +362,7 @@ def benchmark_section(f, load, head):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
+    parser = output.parser(prog, __doc__)
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()

@@ -3,8 +3,8 @@ library in-process, fraccontact.impact) over a matrix that crosses the
 dashpot c from 1e-2 to 1e9 N s/m, specimens from foam (1 MPa) to steel
 (210 GPa), v0 from 1e-4 to 30 m/s, m from 1 g to 1000 kg, steps from 1e-9 s
 to longer than the contact, N up to 1e6, zero velocity, a gap and repeated
-impacts with gravity; and a second matrix over the springpot (damper = 2,
-issue 12): its order alpha from 0.05 to 1, c_alpha over twelve decades, the
+impacts with gravity; and a second matrix over the springpot (damper = 2):
+its order alpha from 0.05 to 1, c_alpha over twelve decades, the
 spring exponent n in {1, 1.5, 2}, both memories (the full G1 history and the
 compressed one), runs of 1e6 steps and repeated impacts under gravity with
 the dent recovering between them (stability/springpot.py).
@@ -31,16 +31,17 @@ Regenerate: scripts/report stability   (pytest runs the FAST subset)
 
 import time
 
-from ... import atomic, reports
+from fraccontact import atomic, output
+
 from . import dashpot, dashpot_report, springpot, springpot_report
 from .core import over
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__)
-    reports.add_solver(parser, "fraccontact-solve, for its GSL reference")
+    parser = output.parser(prog, __doc__)
+    output.add_solver(parser, "fraccontact-solve, for its GSL reference")
     parser.add_argument("--fast", action="store_true", help="the subset pytest runs")
-    args = reports.parse(parser, argv)
+    args = output.parse(parser, argv)
     # The dashpot: its convergence study, then its matrix, every case with every law.
     start = time.monotonic()
     study = over(dashpot.CONVERGENCE, args.fast, dashpot.FAST_CONVERGENCE, "convergence: ",

@@ -6,8 +6,9 @@ findings listed for it, and how a matrix is worked through."""
 import math
 import sys
 
-from ... import model
 from tqdm import tqdm
+
+from fraccontact import model
 
 from .. import BAR
 

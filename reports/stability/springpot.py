@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-from ... import hertz, model
+from fraccontact import hertz, model
+
 from .core import ENERGY, EPS, H20, RESOLVED, judge, rounding, t_end_of
 
 # A springpot case runs the compressed memory (memory = 2) at the case's

@@ -17,8 +17,10 @@ import sys
 
 from tqdm import tqdm
 
-from .. import atomic
-from . import BAR, make_folder, source_tree
+from fraccontact import atomic
+from fraccontact.output import make_folder
+
+from . import BAR, source_tree
 
 ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",
@@ -198,7 +200,7 @@ def main(argv=None, prog=None):
         f = fuzz(args.fuzz_seconds)
         bar.update()
         bar.set_description("hostile input")
-        done = subprocess.run([sys.executable, "-m", "fraccontact", "report", "hostile", "--out", args.out],
+        done = subprocess.run([sys.executable, "-m", "reports", "hostile", "--out", args.out],
                               capture_output=True, text=True)
         bar.update()
     summary = done.stdout.strip().splitlines()[0] if done.stdout.strip() else "the hostile report failed"

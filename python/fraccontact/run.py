@@ -1,4 +1,4 @@
-"""The paper's h20 drop test through the FMU with fmpy: prints F_peak, eps,
+"""fraccontact run: the paper's h20 drop test through the FMU with fmpy: prints F_peak, eps,
 contact time and permanent indentation for both spring laws next to the
 paper's Table 1, and writes the time series (CSV) and a plot (PNG).
 
@@ -11,10 +11,10 @@ import sys
 from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
-from .. import atomic, fmu, model, reports
-from ..options import positive
+from . import atomic, fmu, model, output
+from .options import positive
 
-plt = reports.pyplot()
+plt = output.pyplot()
 
 PAPER = {"F_peak": 1004.0, "eps": 0.59}  # docs/model.md §1, Table 1, h20
 LAWS = {1: "G1 history sum (law 1)", 2: "closed-form Hertz (law 2)"}
@@ -89,7 +89,7 @@ def plot(path, results, figures):
     k = f"{h20['k']:.4g}".replace("e+0", "e")
     fig.suptitle(f"h20 drop test: m = {h20['m']:g} kg, v0 = {h20['v']:.3g} m/s, k = {k} N/m^1.5, "
                  f"c = {h20['c']:g} N s/m")
-    reports.save(fig, path, dpi=110)
+    output.save(fig, path, dpi=110)
 
 
 def check(parser, args):
@@ -108,12 +108,12 @@ def check(parser, args):
 
 
 def main(argv=None, prog=None):
-    parser = reports.parser(prog, __doc__, "folder for h20_drop.csv and h20_drop.png (default: docs/)")
-    reports.add_fmu(parser)
+    parser = output.parser(prog, __doc__, "folder for h20_drop.csv and h20_drop.png (default: docs/)")
+    output.add_fmu(parser)
     parser.add_argument("--stop-time", type=positive, default=3e-3, help="simulated time [s] (default 3e-3)")
     parser.add_argument("--output-interval", type=positive, default=2e-6,
                         help=f"output sampling [s] (default 2e-6; at most {MAX_ROWS:.0e} rows: stop time / interval)")
-    args = reports.parse(parser, argv, check)
+    args = output.parse(parser, argv, check)
 
     try:
         results = {law: simulate(args.fmu, law, args.stop_time, args.output_interval) for law in LAWS}
