@@ -329,7 +329,7 @@ static int check_method(const option_table *t, options *o)
         value = typed_value(t, o, "--rtol");
         return value ? bad_option("--rtol", value, "the relative tolerance of --reference, which is not given") : 0;
     }
-    if (o->p.damper != 1)
+    if (o->p.model.damper != 1)
         return bad_option("--damper", typed_value(t, o, "--damper"),
                           "--reference integrates the dashpot (damper 1) only: a springpot has no ODE for GSL "
                           "(compare --memory 1 with --memory 2 instead)");
@@ -339,12 +339,12 @@ static int check_method(const option_table *t, options *o)
         if ((value = typed_value(t, o, model_steps[i])))
             fprintf(stderr, PROGRAM ": warning: %s '%s' has no effect with --reference: GSL takes its own steps (to "
                     "--rtol)\n", model_steps[i], value);
-    if (o->p.law != 2 && o->p.g1_nodes == 0) {
+    if (o->p.model.law != 2 && o->p.model.g1_nodes == 0) {
         if ((value = typed_value(t, o, "--law")))
             return bad_option("--law", value,
                               "--reference solves the continuous law: hertz, or g1 and g1x with --g1-nodes N > 0 "
                               "(with N the steps since onset the G1 laws tend to hertz as dt_max shrinks)");
-        o->p.law = 2; /* the default law's limit, which the reference solves */
+        o->p.model.law = 2; /* the default law's limit, which the reference solves */
     }
     return 0;
 }
@@ -566,12 +566,12 @@ static void print_table(const options *o, const fc_result *r, double cpu_seconds
                                         "separation"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.law], f->k, o->p.spring_exponent);
-    if (o->p.damper == 2)
-        printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.damper_order, o->p.c_alpha,
-               o->p.damper_order, o->p.memory == 1 ? "full G1 history" : "compressed");
+    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.model.law], f->k, o->p.model.spring_exponent);
+    if (o->p.model.damper == 2)
+        printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.model.damper_order, o->p.model.c_alpha,
+               o->p.model.damper_order, o->p.model.memory == 1 ? "full G1 history" : "compressed");
     else
-        printf("c = %.6g N s/m, ", o->p.c);
+        printf("c = %.6g N s/m, ", o->p.model.c);
     printf("m = %.6g kg, v = %.6g m/s\n", o->p.m, o->p.v);
     if (r->n_impacts > 0) {
         printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");
