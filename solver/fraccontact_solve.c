@@ -558,16 +558,26 @@ static void print_json(const options *o, const fc_result *r, double cpu_seconds)
     printf("}}\n");
 }
 
+/* The word of the law's code, from the library's table. */
+static const char *law_word(int law, char word[32])
+{
+    size_t i;
+    for (i = 0; i < fc_parameter_count(); i++)
+        if (strcmp(fc_parameter_at(i)->name, "law") == 0 && nth_word(fc_parameter_at(i)->words, law - 1, word))
+            return word;
+    return "?";
+}
+
 static void print_table(const options *o, const fc_result *r, double cpu_seconds)
 {
-    static const char *const laws[] = {"", "g1", "hertz", "g1x"};
+    char law[32];
     static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
                                         "the striker moves away and nothing brings it back",
                                         "the striker came to rest in contact: the force decayed without a "
                                         "separation"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.model.law], f->k, o->p.model.spring_exponent);
+    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), law_word(o->p.model.law, law), f->k, o->p.model.spring_exponent);
     if (o->p.model.damper == 2)
         printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.model.damper_order, o->p.model.c_alpha,
                o->p.model.damper_order, o->p.model.memory == 1 ? "full G1 history" : "compressed");
