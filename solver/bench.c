@@ -172,9 +172,9 @@ static int bench_batch(size_t N, int law, double dt_max)
         return 1;
     for (i = 0; i < N; i++) {
         fc_params_default(&p[i]);
-        p[i].law = law;
-        p[i].dt_max = dt_max;
-        p[i].c = 4000.0 + 4000.0 * (double)i / (double)N;
+        p[i].model.law = law;
+        p[i].model.dt_max = dt_max;
+        p[i].model.c = 4000.0 + 4000.0 * (double)i / (double)N;
     }
     for (r = 0; r < 5; r++) {
         double t0 = cpu_seconds();
@@ -369,9 +369,9 @@ static int bench_springpot(double largest)
 static void controlled_params(fc_params *p, int damper, double tolerance)
 {
     fc_params_default(p);
-    p->law = CONTACT_LAW_HERTZ;
-    p->tolerance = tolerance;
-    p->damper = damper;
+    p->model.law = CONTACT_LAW_HERTZ;
+    p->model.tolerance = tolerance;
+    p->model.damper = damper;
 }
 
 static void print_controlled(const char *name, const fc_outcome *o, double seconds)

@@ -8,48 +8,22 @@
 #include "contact.h"
 #include "run.h"
 
-#define AT(name) offsetof(fc_params, name)
+/* The library's rows of parameters.def, in its order. */
+#define ROW(name, type, at, unit, words, description) \
+    {#name, FC_KIND_##type, offsetof(fc_params, at), unit, description, words},
+#define FC_KIND_Real FC_REAL
+#define FC_KIND_Integer FC_INTEGER
+#define LIBRARY_ROW(name, type, unit, value, min, max, vr, index, variability, words, rule, description) \
+    ROW(name, type, name, unit, words, description)
+#define MODEL_ROW(name, type, unit, value, min, max, vr, index, variability, words, rule, description) \
+    ROW(name, type, model.name, unit, words, description)
 
 static const fc_parameter parameters[] = {
-    {"v", FC_REAL, AT(v), "m/s", "striker velocity towards the specimen; driven scene: the indentation rate"},
-    {"m", FC_REAL, AT(m), "kg", "striker mass; driven scene: 0 = no inertia"},
-    {"v2", FC_REAL, AT(v2), "m/s",
-     "the second body's velocity along the striker's axis: the model's striker moves at the approach speed v - v2"},
-    {"m2", FC_REAL, AT(m2), "kg",
-     "the second body's mass; 0 = held fixed; > 0: the model's striker has the reduced mass m m2/(m + m2)"},
-    {"R", FC_REAL, AT(R), "m", "striker tip radius (used only with k = 0)"},
-    {"E_i", FC_REAL, AT(E_i), "Pa", "indenter Young's modulus (used only with k = 0)"},
-    {"nu_i", FC_REAL, AT(nu_i), "1", "indenter Poisson ratio (used only with k = 0)"},
-    {"E_s", FC_REAL, AT(E_s), "Pa", "specimen Young's modulus (used only with k = 0)"},
-    {"nu_s", FC_REAL, AT(nu_s), "1", "specimen Poisson ratio (used only with k = 0)"},
-    {"k", FC_REAL, AT(k), "N/m1.5",
-     "spring constant [N/m^n]; 0 derives the Hertz constant from R, E_i, nu_i, E_s, nu_s (n = 1.5 only); any "
-     "other value wins over them"},
-    {"spring_exponent", FC_REAL, AT(spring_exponent), "1",
-     "n in F = k x1^n: 1.5 Hertz sphere, 1 linear spring (flat punch), 2 cone-like tip"},
-    {"c", FC_REAL, AT(c), "N.s/m", "dashpot constant (damper 1)"},
-    {"damper_order", FC_REAL, AT(damper_order), "1", "the springpot's order alpha in (0, 1]; 1 is a dashpot (damper 2)"},
-    {"c_alpha", FC_REAL, AT(c_alpha), "N.s^alpha/m", "springpot constant: F = c_alpha D^alpha x2 (damper 2)"},
-    {"memory_tolerance", FC_REAL, AT(memory_tolerance), "1",
-     "relative error of the compressed memory's kernel, from the fixed step (error-controlled steps: from min(dt_max, "
-     "1e-9 s)) to 1000 s (memory 2)"},
-    {"tolerance", FC_REAL, AT(tolerance), "1",
-     "relative error per internal step (error-controlled steps, ESDIRK 5(4) or the springpot's Radau IIA, capped by "
-     "dt_max only when dt_max > 0); 0 = fixed steps of dt_max"},
-    {"dt_max", FC_REAL, AT(dt_max), "s",
-     "largest internal step; 0 = fixed steps of 1e-7 s and no cap on error-controlled steps; in contact, where fewer "
-     "than 6 fixed steps would fit in the time the spring takes to stop the striker, they are 4000 in that time"},
-    {"g", FC_REAL, AT(g), "m/s2", "acceleration of the striker towards the specimen (9.81 for gravity)"},
-    {"gap0", FC_REAL, AT(gap0), "m", "gap between striker and specimen at t = 0"},
-    {"t_end", FC_REAL, AT(t_end), "s", "stop at this time if the run has not stopped before"},
-    {"law", FC_INTEGER, AT(law), "1", "spring law: 1 G1 history sum, 2 closed-form Hertz, 3 G1 with Richardson extrapolation"},
-    {"g1_nodes", FC_INTEGER, AT(g1_nodes), "1", "G1 intervals N; 0: internal steps since contact onset"},
-    {"scene", FC_INTEGER, AT(scene), "1", "1 drop test (a free striker), 2 driven (the rate v prescribed)"},
-    {"scheme", FC_INTEGER, AT(scheme), "1", "1 SDIRK2 (implicit, L-stable), 2 the paper's explicit central differences"},
-    {"damper", FC_INTEGER, AT(damper), "1", "1 dashpot F = c x2', 2 springpot F = c_alpha D^alpha x2 (fractional memory)"},
-    {"memory", FC_INTEGER, AT(memory), "1",
-     "the springpot's memory: 1 full G1 history (steps of dt_max, O(N) each), 2 compressed (sum of exponentials)"},
-    {"impacts", FC_INTEGER, AT(impacts), "1", "stop right after this many impacts have ended"},
+#define INPUT_FMU_LIBRARY LIBRARY_ROW
+#define PARAMETER_MODEL_FMU_LIBRARY MODEL_ROW
+#define PARAMETER_MODEL_LIBRARY MODEL_ROW
+#define STOP_LIBRARY LIBRARY_ROW
+#include "parameters.def"
 };
 
 #define N_PARAMETERS (sizeof parameters / sizeof parameters[0])
@@ -68,71 +42,23 @@ void fc_striker(const fc_params *p, double *v, double *m)
     *m = contact_reduced_mass(p->m, p->m2);
 }
 
-void fc_model_params(const fc_params *p, contact_params *q)
-{
-    q->R = p->R;
-    q->E_i = p->E_i;
-    q->nu_i = p->nu_i;
-    q->E_s = p->E_s;
-    q->nu_s = p->nu_s;
-    q->k = p->k;
-    q->spring_exponent = p->spring_exponent;
-    q->c = p->c;
-    q->damper_order = p->damper_order;
-    q->c_alpha = p->c_alpha;
-    q->memory_tolerance = p->memory_tolerance;
-    q->tolerance = p->tolerance;
-    q->dt_max = p->dt_max;
-    q->g = p->g;
-    q->gap0 = p->gap0;
-    q->law = p->law;
-    q->g1_nodes = p->g1_nodes;
-    q->scene = p->scene;
-    q->scheme = p->scheme;
-    q->damper = p->damper;
-    q->memory = p->memory;
-}
-
 void fc_params_default(fc_params *p)
 {
-    contact_params q;
     memset(p, 0, sizeof *p);
-    contact_default_params(&q);
-    contact_default_striker(&p->v, &p->m);
-    p->R = q.R;
-    p->E_i = q.E_i;
-    p->nu_i = q.nu_i;
-    p->E_s = q.E_s;
-    p->nu_s = q.nu_s;
-    p->k = q.k;
-    p->spring_exponent = q.spring_exponent;
-    p->c = q.c;
-    p->damper_order = q.damper_order;
-    p->c_alpha = q.c_alpha;
-    p->memory_tolerance = q.memory_tolerance;
-    p->tolerance = q.tolerance;
-    p->dt_max = q.dt_max;
-    p->g = q.g;
-    p->gap0 = q.gap0;
-    p->law = q.law;
-    p->g1_nodes = q.g1_nodes;
-    p->scene = q.scene;
-    p->scheme = q.scheme;
-    p->damper = q.damper;
-    p->memory = q.memory;
-    p->t_end = 1.0;
-    p->impacts = 1;
+#define INPUT_FMU_LIBRARY(name, type, unit, value, ...) p->name = value;
+#define STOP_LIBRARY(name, type, unit, value, ...) p->name = value;
+#include "parameters.def"
+    contact_default_params(&p->model);
 }
 
 fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
 {
-    contact_params q;
+    const contact_params *q = &p->model;
     double v, m;
-    fc_model_params(p, &q);
     fc_striker(p, &v, &m);
-    if (contact_check_params(&q, msg, len) != 0
-        || contact_check_bodies(&q, q.scene, p->v, p->m, p->v2, p->m2, msg, len) != 0
-        || contact_check_resolution(&q, v, m, msg, len) != 0)
+    if (contact_check_params(q, msg, len) != 0
+        || contact_check_bodies(q, q->scene, p->v, p->m, p->v2, p->m2, msg, len) != 0
+        || contact_check_resolution(q, v, m, msg, len) != 0)
         return FC_EINVAL;
     if (!(p->t_end > 0.0) || !isfinite(p->t_end)) {
         contact_reject(msg, len, "t_end", p->t_end, "the time limit must be positive and finite [s]");
@@ -144,7 +70,7 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
     }
     /* A run stops at its first separation after one impact, or where
      * nothing brings the striker back. */
-    if (contact_check_history_span(&q, v, m, p->t_end, p->impacts == 1 || !(p->g > 0.0), "t_end", msg, len)
+    if (contact_check_history_span(q, v, m, p->t_end, p->impacts == 1 || !(q->g > 0.0), "t_end", msg, len)
         != 0)
         return FC_EINVAL;
     return FC_OK;
@@ -152,12 +78,11 @@ fc_status fc_params_check(const fc_params *p, char *msg, size_t len)
 
 size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, double *eta, char *msg, size_t len)
 {
-    contact_params q;
+    contact_params q = p->model;
     contact_model cm;
     size_t i;
     if (fc_params_check(p, msg, len) != FC_OK)
         return 0;
-    fc_model_params(p, &q);
     q.damper = CONTACT_DAMPER_SPRINGPOT;
     q.memory = CONTACT_MEMORY_COMPRESSED;
     memset(&cm, 0, sizeof cm);
@@ -173,9 +98,7 @@ size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, do
 
 double fc_step_limit(const fc_params *p)
 {
-    contact_params q;
-    fc_model_params(p, &q);
-    return contact_step_limit(&q);
+    return contact_step_limit(&p->model);
 }
 
 double fc_drop_velocity(double height)
@@ -185,26 +108,20 @@ double fc_drop_velocity(double height)
 
 int fc_params_warning(const fc_params *p, char *msg, size_t len)
 {
-    contact_params q;
     double v, m;
-    fc_model_params(p, &q);
     fc_striker(p, &v, &m);
-    return contact_unused_value(&q, msg, len) || contact_step_warning(&q, v, m, msg, len)
-           || contact_arrival_warning(&q, v, msg, len);
+    return contact_unused_value(&p->model, msg, len) || contact_step_warning(&p->model, v, m, msg, len)
+           || contact_arrival_warning(&p->model, v, msg, len);
 }
 
 int fc_error_controlled(const fc_params *p)
 {
-    contact_params q;
-    fc_model_params(p, &q);
-    return contact_error_controlled(&q);
+    return contact_error_controlled(&p->model);
 }
 
 const char *fc_method_name(const fc_params *p)
 {
-    contact_params q;
-    fc_model_params(p, &q);
-    return contact_method_name(contact_method(&q));
+    return contact_method_name(contact_method(&p->model));
 }
 
 /* t_c v / x_max of an elastic impact on the spring k x1^n (docs/model.md §2):
@@ -219,21 +136,20 @@ static double elastic_contact_time(double n)
  * striker never meets the specimen. */
 static double contact_time(const fc_params *p)
 {
-    contact_params q;
+    contact_params q = p->model;
     contact_model cm;
     double x_ref, t_ref, x_small, v, m;
-    fc_model_params(p, &q);
     fc_striker(p, &v, &m);
     q.damper = CONTACT_DAMPER_DASHPOT; /* the spring's alone: no springpot's memory to build */
     contact_start(&cm, &q, v, m);
     contact_scales(&q, contact_spring_stiffness(&cm, 0), v, m, &x_ref, &t_ref, &x_small);
-    return t_ref > 0.0 ? elastic_contact_time(p->spring_exponent) * t_ref : 0.0;
+    return t_ref > 0.0 ? elastic_contact_time(p->model.spring_exponent) * t_ref : 0.0;
 }
 
 /* Whether the run is one contact as long as the run: the driven scene without mass. */
 static int driven_rate(const fc_params *p)
 {
-    return p->scene == CONTACT_SCENE_DRIVEN && !(p->m > 0.0);
+    return p->model.scene == CONTACT_SCENE_DRIVEN && !(p->m > 0.0);
 }
 
 double fc_default_output_interval(const fc_params *p)
@@ -251,13 +167,13 @@ double fc_default_output_interval(const fc_params *p)
  * under g: gap0 = v t + g t^2 / 2), or infinity when it never does. */
 static double onset_time(const fc_params *p)
 {
-    double g = driven_rate(p) ? 0.0 : p->g, v, m, root, speed;
+    double g = driven_rate(p) ? 0.0 : p->model.g, v, m, root, speed;
     fc_striker(p, &v, &m);
-    root = v * v + 2.0 * g * p->gap0;
-    if (p->gap0 == 0.0 && (v > 0.0 || (v == 0.0 && g > 0.0)))
+    root = v * v + 2.0 * g * p->model.gap0;
+    if (p->model.gap0 == 0.0 && (v > 0.0 || (v == 0.0 && g > 0.0)))
         return 0.0;
     speed = root >= 0.0 ? v + sqrt(root) : 0.0;
-    return speed > 0.0 ? 2.0 * p->gap0 / speed : INFINITY;
+    return speed > 0.0 ? 2.0 * p->model.gap0 / speed : INFINITY;
 }
 
 /* The least a run must cover before it may stop, short of t_end [s]: none
@@ -274,7 +190,7 @@ static double least_span(const fc_params *p, double *in_contact)
         return 0.0;
     if (!(onset < end))
         return end;
-    contacts = driven_rate(p) ? end : contact_time(p) * (p->g > 0.0 ? (double)p->impacts : 1.0);
+    contacts = driven_rate(p) ? end : contact_time(p) * (p->model.g > 0.0 ? (double)p->impacts : 1.0);
     *in_contact = fmin(contacts, end - onset);
     return onset + *in_contact;
 }
@@ -284,10 +200,8 @@ static double least_span(const fc_params *p, double *in_contact)
  * contacts, or over the whole span on a uniform grid. */
 static double least_steps(const fc_params *p)
 {
-    contact_params q;
     double in_contact, span = least_span(p, &in_contact);
-    fc_model_params(p, &q);
-    return contact_least_steps(&q, span, in_contact);
+    return contact_least_steps(&p->model, span, in_contact);
 }
 
 static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_t len)
@@ -297,7 +211,7 @@ static fc_status reject_steps(const fc_params *p, double steps, char *msg, size_
              "the run would take at least %.3g internal steps of at most %.3g s, more than %.0e; raise dt_max, or "
              "lower t_end or impacts",
              steps, fc_step_limit(p), FC_STEPS_MAX);
-    contact_reject(msg, len, "dt_max", p->dt_max, rule);
+    contact_reject(msg, len, "dt_max", p->model.dt_max, rule);
     return FC_EINVAL;
 }
 
@@ -544,7 +458,7 @@ static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
 static fc_status run(const fc_params *p, double interval, series *out, impact_list *impacts, watch *w,
                      contact_kernel *kernel, fc_outcome *o, char *msg, size_t len)
 {
-    contact_params q;
+    const contact_params *q = &p->model;
     contact_model cm, snapshot;
     double E_diss_onset = 0.0;
     int64_t k = 1;
@@ -553,13 +467,12 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     memset(o, 0, sizeof *o);
     if (fc_run_check(p, out ? interval : FC_NO_ROWS, msg, len) != FC_OK)
         return o->status = FC_EINVAL;
-    fc_model_params(p, &q);
     fc_striker(p, &v, &m);
-    dt = contact_step_limit(&q);
-    contact_start_with(&cm, &q, v, m, kernel);
+    dt = contact_step_limit(q);
+    contact_start_with(&cm, q, v, m, kernel);
     watch_run(w, &cm);
-    uniform = contact_steps_uniformly(&q);
-    grid = rows_on_grid(&q);
+    uniform = contact_steps_uniformly(q);
+    grid = rows_on_grid(q);
     if (out)
         keep(out, &cm);
     while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * dt : 0.0))) {

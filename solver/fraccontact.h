@@ -7,7 +7,7 @@
  *   fc_result r;
  *   char why[FC_MESSAGE_SIZE];
  *   fc_params_default(&p);          the paper's h20 drop test
- *   p.c = 5000.0;
+ *   p.model.c = 5000.0;
  *   if (fc_run(&p, FC_NO_ROWS, &r, why, sizeof why) != FC_OK) ...
  *   ... r.outcome.first.F_peak, r.per_impact[i].eps ...
  *   fc_result_free(&r);
@@ -18,6 +18,8 @@
 
 #include <stddef.h>
 #include <stdint.h>
+
+#include "contact.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,35 +49,16 @@ typedef enum {
 
 #define FC_MESSAGE_SIZE 512
 
-/* The FMU's variables by their names, and the run's stop conditions. */
+/* The FMU's variables by their names, and the run's stop conditions: the
+ * library's rows of fmu_src/model/parameters.def, which says what each is
+ * (fc_parameter_at tells them at run time). The model's parameters are the
+ * member model (p.model.c, p.model.dt_max). */
 typedef struct {
-    double v;        /* striker velocity towards the specimen [m/s]; driven scene: the indentation rate */
-    double m;        /* striker mass [kg]; driven scene: 0 = no inertia */
-    double v2;       /* the second body's velocity [m/s]: the model's striker moves at v - v2 */
-    double m2;       /* the second body's mass [kg]; 0 = held fixed; > 0: the reduced mass m m2/(m + m2) */
-    double R;        /* striker tip radius [m] */
-    double E_i;      /* indenter Young's modulus [Pa] */
-    double nu_i;     /* indenter Poisson ratio */
-    double E_s;      /* specimen Young's modulus [Pa] */
-    double nu_s;     /* specimen Poisson ratio */
-    double k;        /* spring constant [N/m^n]; 0: the Hertz constant from R, E_i, nu_i, E_s, nu_s */
-    double spring_exponent; /* n in F = k x1^n (1.5 Hertz sphere) */
-    double c;        /* dashpot constant [N s/m] */
-    double damper_order;     /* the springpot's alpha in (0, 1] */
-    double c_alpha;          /* springpot constant [N s^alpha/m] */
-    double memory_tolerance; /* relative error of the compressed memory's kernel */
-    double tolerance;        /* relative error per internal step; 0: fixed steps of dt_max */
-    double dt_max;   /* largest internal step [s]; 0: fixed steps of 1e-7 s, error-controlled ones uncapped */
-    double g;        /* acceleration of the striker towards the specimen [m/s^2] */
-    double gap0;     /* gap between striker and specimen at t = 0 [m] */
-    double t_end;    /* stop at this time [s] */
-    int law;         /* 1 G1 history sum, 2 closed-form Hertz, 3 G1 with Richardson extrapolation */
-    int g1_nodes;    /* G1 intervals N; 0: internal steps since contact onset */
-    int scene;       /* 1 drop test, 2 driven */
-    int scheme;      /* 1 SDIRK2 (implicit, L-stable), 2 the paper's central differences */
-    int damper;      /* 1 dashpot, 2 springpot (docs/model.md §5) */
-    int memory;      /* the springpot's memory: 1 full G1 history, 2 compressed (docs/model.md §6) */
-    int impacts;     /* stop right after this many impacts have ended */
+#define INPUT_FMU_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#include "parameters.def"
+    contact_params model;
+#define STOP_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#include "parameters.def"
 } fc_params;
 
 /* The paper's h20 drop test (docs/model.md §1): v = sqrt(2 9.81 0.020), m =
@@ -93,7 +76,7 @@ FC_API double fc_drop_velocity(double height);
  * the other damper's parameters), else 0. */
 FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 
-/* 1 when the run chooses its steps by p->tolerance (Kvaerno's ESDIRK 5(4)),
+/* 1 when the run chooses its steps by p->model.tolerance (Kvaerno's ESDIRK 5(4)),
  * 0 when it takes fixed steps of dt_max. */
 FC_API int fc_error_controlled(const fc_params *p);
 
@@ -112,9 +95,10 @@ typedef enum { FC_REAL = 0, FC_INTEGER = 1 } fc_kind;
 typedef struct {
     const char *name;    /* the member's (and the FMU variable's) name */
     fc_kind kind;        /* double or int */
-    size_t offset;       /* offsetof(fc_params, name) */
+    size_t offset;       /* offsetof(fc_params, name), of model.name for the model's */
     const char *unit;    /* SI unit, "1" for a number */
     const char *help;    /* one line */
+    const char *words;   /* the words an integer's codes 1, 2, ... also take, space-separated ("" for none) */
 } fc_parameter;
 
 /* The i-th parameter (0 <= i < fc_parameter_count()), in a fixed order;

@@ -33,7 +33,7 @@ typedef struct {
 
 /* ------------------------------------------------------------ options */
 
-typedef enum { REAL, INTEGER, LAW, SCHEME, SCENE, TEXT, FLAG } option_kind;
+typedef enum { REAL, INTEGER, WORD, TEXT, FLAG } option_kind;
 
 /* A rule an option's value must follow: NULL when it does, else the rule. */
 typedef const char *(*option_rule)(const void *value);
@@ -45,6 +45,7 @@ typedef struct {
     char help[512];
     const char *variable; /* the library's name for it, as in its messages */
     option_rule rule;     /* for the solver's own options (the library checks its own) */
+    const char *words;    /* a WORD's words for its codes 1, 2, ..., space-separated (the library's table) */
 } option;
 
 typedef struct {
@@ -70,16 +71,20 @@ static const char *repeat_count(const void *value)
     return n >= 1 && n <= 100000 ? NULL : "must lie in 1..100000";
 }
 
-static const char *const law_words[] = {"g1", "hertz", "g1x", NULL};
-static const char *const scheme_words[] = {"sdirk2", "central", NULL};
-static const char *const scene_words[] = {"drop", "driven", NULL};
-
-/* The words an integer parameter also takes, and its kind. */
-static option_kind word_kind(const char *name, const char *const **words)
+/* The i-th (from 0) of the space-separated words into word; 0 past the last. */
+static int nth_word(const char *words, int i, char word[32])
 {
-    *words = strcmp(name, "law") == 0 ? law_words : strcmp(name, "scheme") == 0 ? scheme_words
-             : strcmp(name, "scene") == 0 ? scene_words : NULL;
-    return !*words ? INTEGER : strcmp(name, "law") == 0 ? LAW : strcmp(name, "scheme") == 0 ? SCHEME : SCENE;
+    size_t n;
+    for (;; words += n) {
+        words += strspn(words, " ");
+        n = strcspn(words, " ");
+        if (n == 0)
+            return 0;
+        if (i-- == 0)
+            break;
+    }
+    snprintf(word, 32, "%.*s", (int)n, words);
+    return 1;
 }
 
 static void add_option(option_table *t, const char *name, option_kind kind, size_t offset, const char *variable,
@@ -91,6 +96,7 @@ static void add_option(option_table *t, const char *name, option_kind kind, size
     o->offset = offset;
     o->variable = variable;
     o->rule = rule;
+    o->words = "";
     snprintf(o->help, sizeof o->help, "%s", help);
 }
 
@@ -106,11 +112,11 @@ static void make_options(option_table *t)
                "drop height h [m]: v = sqrt(2 * 9.81 * h) (instead of --v)");
     for (i = 0; i < fc_parameter_count(); i++) {
         const fc_parameter *p = fc_parameter_at(i);
-        const char *const *words;
         const void *value = (const char *)&defaults + p->offset;
-        char name[32], help[512], shown[64];
-        size_t k, w;
-        option_kind kind = p->kind == FC_REAL ? REAL : word_kind(p->name, &words);
+        char name[32], help[512], shown[64], word[32];
+        size_t k;
+        int w;
+        option_kind kind = p->kind == FC_REAL ? REAL : *p->words ? WORD : INTEGER;
         snprintf(name, sizeof name, "--%s", p->name);
         for (k = 2; name[k]; k++)
             name[k] = name[k] == '_' ? '-' : name[k];
@@ -119,10 +125,10 @@ static void make_options(option_table *t)
         else
             snprintf(shown, sizeof shown, "%d", *(const int *)value);
         snprintf(help, sizeof help, "%s [%s] (default %s)", p->help, p->unit, shown);
-        if (kind != REAL && kind != INTEGER)
-            for (w = 0; words[w]; w++)
-                snprintf(help + strlen(help), sizeof help - strlen(help), "%s%s", w ? ", " : "; or ", words[w]);
+        for (w = 0; nth_word(p->words, w, word); w++)
+            snprintf(help + strlen(help), sizeof help - strlen(help), "%s%s", w ? ", " : "; or ", word);
         add_option(t, name, kind, offsetof(options, p) + p->offset, p->name, NULL, help);
+        t->list[t->n - 1].words = p->words;
     }
     add_option(t, "--output-interval", REAL, offsetof(options, output_interval), "output_interval", finite_nonnegative,
                "time between rows of --csv [s], besides a row at every contact onset and separation; 0 = a row "
@@ -195,22 +201,21 @@ static void print_json_string(const char *text)
 /* The option table as JSON, for programs that drive the solver. */
 static void list_options(const option_table *t)
 {
-    static const char *const kinds[] = {"real", "integer", "word", "word", "word", "text", "flag"};
+    static const char *const kinds[] = {"real", "integer", "word", "text", "flag"};
     size_t i;
     printf("[");
     for (i = 0; i < t->n; i++) {
         const option *o = &t->list[i];
-        const char *const *words = o->kind == LAW ? law_words : o->kind == SCHEME ? scheme_words
-                                   : o->kind == SCENE ? scene_words : NULL;
+        char word[32];
         printf("%s\n {\"option\": ", i ? "," : "");
         print_json_string(o->name);
         printf(", \"kind\": \"%s\", \"help\": ", kinds[o->kind]);
         print_json_string(o->help);
-        if (words) {
+        if (o->kind == WORD) {
             int w;
             printf(", \"choices\": [");
-            for (w = 0; words[w]; w++)
-                printf("%s\"%s\"", w ? ", " : "", words[w]);
+            for (w = 0; nth_word(o->words, w, word); w++)
+                printf("%s\"%s\"", w ? ", " : "", word);
             printf("]");
         }
         printf("}");
@@ -226,27 +231,26 @@ static int bad_option(const char *name, const char *value, const char *why)
 }
 
 /* "one of WORD, ... or 1, ..., n": what a word option takes. */
-static const char *word_rule(const char *const words[], char *rule, size_t len)
+static const char *word_rule(const char *words, char *rule, size_t len)
 {
     int i, n;
     size_t used;
-    for (n = 0; words[n]; n++)
-        ;
+    char word[32];
     used = (size_t)snprintf(rule, len, "one of");
-    for (i = 0; i < n && used < len; i++)
-        used += (size_t)snprintf(rule + used, len - used, "%s %s", i ? "," : "", words[i]);
+    for (n = 0; nth_word(words, n, word) && used < len; n++)
+        used += (size_t)snprintf(rule + used, len - used, "%s %s", n ? "," : "", word);
     for (i = 1; i <= n && used < len; i++)
         used += (size_t)snprintf(rule + used, len - used, "%s%d", i == 1 ? " or " : ", ", i);
     return rule;
 }
 
-static int parse_word(const char *value, const char *const words[], int *out)
+static int parse_word(const char *value, const char *words, int *out)
 {
     int i;
-    char *end;
+    char *end, word[32];
     long n = strtol(value, &end, 10);
-    for (i = 0; words[i]; i++)
-        if (strcmp(value, words[i]) == 0) {
+    for (i = 0; nth_word(words, i, word); i++)
+        if (strcmp(value, word) == 0) {
             *out = i + 1;
             return 0;
         }
@@ -277,13 +281,10 @@ static int set_option(options *o, const option *opt, const char *value)
         *(int *)at = (int)n;
         break;
     }
-    case LAW:
-    case SCHEME:
-    case SCENE: {
-        const char *const *words = opt->kind == LAW ? law_words : opt->kind == SCHEME ? scheme_words : scene_words;
-        return parse_word(value, words, (int *)at) ? bad_option(opt->name, value, word_rule(words, rule, sizeof rule))
-                                                   : 0;
-    }
+    case WORD:
+        return parse_word(value, opt->words, (int *)at)
+                   ? bad_option(opt->name, value, word_rule(opt->words, rule, sizeof rule))
+                   : 0;
     case TEXT:
         *(const char **)at = value;
         break;
@@ -329,7 +330,7 @@ static int check_method(const option_table *t, options *o)
         value = typed_value(t, o, "--rtol");
         return value ? bad_option("--rtol", value, "the relative tolerance of --reference, which is not given") : 0;
     }
-    if (o->p.damper != 1)
+    if (o->p.model.damper != 1)
         return bad_option("--damper", typed_value(t, o, "--damper"),
                           "--reference integrates the dashpot (damper 1) only: a springpot has no ODE for GSL "
                           "(compare --memory 1 with --memory 2 instead)");
@@ -339,12 +340,12 @@ static int check_method(const option_table *t, options *o)
         if ((value = typed_value(t, o, model_steps[i])))
             fprintf(stderr, PROGRAM ": warning: %s '%s' has no effect with --reference: GSL takes its own steps (to "
                     "--rtol)\n", model_steps[i], value);
-    if (o->p.law != 2 && o->p.g1_nodes == 0) {
+    if (o->p.model.law != 2 && o->p.model.g1_nodes == 0) {
         if ((value = typed_value(t, o, "--law")))
             return bad_option("--law", value,
                               "--reference solves the continuous law: hertz, or g1 and g1x with --g1-nodes N > 0 "
                               "(with N the steps since onset the G1 laws tend to hertz as dt_max shrinks)");
-        o->p.law = 2; /* the default law's limit, which the reference solves */
+        o->p.model.law = 2; /* the default law's limit, which the reference solves */
     }
     return 0;
 }
@@ -557,21 +558,31 @@ static void print_json(const options *o, const fc_result *r, double cpu_seconds)
     printf("}}\n");
 }
 
+/* The word of the law's code, from the library's table. */
+static const char *law_word(int law, char word[32])
+{
+    size_t i;
+    for (i = 0; i < fc_parameter_count(); i++)
+        if (strcmp(fc_parameter_at(i)->name, "law") == 0 && nth_word(fc_parameter_at(i)->words, law - 1, word))
+            return word;
+    return "?";
+}
+
 static void print_table(const options *o, const fc_result *r, double cpu_seconds)
 {
-    static const char *const laws[] = {"", "g1", "hertz", "g1x"};
+    char law[32];
     static const char *const stops[] = {"", "the requested impacts ended", "--t-end reached",
                                         "the striker moves away and nothing brings it back",
                                         "the striker came to rest in contact: the force decayed without a "
                                         "separation"};
     const fc_outcome *f = &r->outcome;
     size_t i;
-    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), laws[o->p.law], f->k, o->p.spring_exponent);
-    if (o->p.damper == 2)
-        printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.damper_order, o->p.c_alpha,
-               o->p.damper_order, o->p.memory == 1 ? "full G1 history" : "compressed");
+    printf("%s, law %s, k = %.6g N/m^%g, ", method_name(o), law_word(o->p.model.law, law), f->k, o->p.model.spring_exponent);
+    if (o->p.model.damper == 2)
+        printf("springpot alpha = %g, c_alpha = %.6g N s^%g/m, memory %s, ", o->p.model.damper_order, o->p.model.c_alpha,
+               o->p.model.damper_order, o->p.model.memory == 1 ? "full G1 history" : "compressed");
     else
-        printf("c = %.6g N s/m, ", o->p.c);
+        printf("c = %.6g N s/m, ", o->p.model.c);
     printf("m = %.6g kg, v = %.6g m/s\n", o->p.m, o->p.v);
     if (r->n_impacts > 0) {
         printf("  impact  t_onset [s]  v_onset [m/s]  F_peak [N]        eps  t_contact [s]  x2_end [m]  E_diss [J]\n");

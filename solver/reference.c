@@ -172,7 +172,7 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
                     char *msg, size_t len)
 {
     fc_outcome *r = &result->outcome;
-    contact_params model, *p = &model;
+    const contact_params *p = &params->model;
     const double t_end = params->t_end;
     double v0, m;
     contact_model cm;
@@ -185,7 +185,6 @@ int reference_solve(const fc_params *params, double rtol, double out_dt, referen
     int in_contact, out_of_memory = 0, stopped = 0;
     gsl_error_handler_t *previous = gsl_set_error_handler_off();
 
-    fc_model_params(params, &model);
     fc_striker(params, &v0, &m);
     v_onset = v0;
     if (p->damper != CONTACT_DAMPER_DASHPOT) {

@@ -34,9 +34,6 @@ fc_status run_rows_check(const fc_params *p, double interval, double steps, char
  * (docs/two_bodies.md). */
 void fc_striker(const fc_params *p, double *v, double *m);
 
-/* The model's parameters of a run. */
-void fc_model_params(const fc_params *p, contact_params *q);
-
 /* Appends; -1 when memory runs out (the list is unchanged). */
 int impact_list_add(impact_list *l, const fc_impact *f);
 

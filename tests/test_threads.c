@@ -200,13 +200,13 @@ static void run_batch(run *r)
     for (i = 0; i < BATCH; i++) {
         const configuration *c = &configurations[i];
         library.params_default(&p[i]);
-        p[i].law = c->law;
-        p[i].damper = c->damper;
-        p[i].memory = c->memory;
-        p[i].dt_max = c->dt_max;
-        p[i].tolerance = c->tolerance;
-        p[i].c *= scale(r->variant);
-        p[i].c_alpha *= scale(r->variant);
+        p[i].model.law = c->law;
+        p[i].model.damper = c->damper;
+        p[i].model.memory = c->memory;
+        p[i].model.dt_max = c->dt_max;
+        p[i].model.tolerance = c->tolerance;
+        p[i].model.c *= scale(r->variant);
+        p[i].model.c_alpha *= scale(r->variant);
     }
     r->failed = library.run_batch(BATCH, p, r->outcomes) != FC_OK;
 }

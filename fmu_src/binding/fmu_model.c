@@ -27,7 +27,9 @@ typedef struct {
  * accelerations the forces other than this contact give each of them
  * (docs/two_bodies.md). The model's striker is their relative motion. */
 typedef struct {
-    double v, m, v2, m2, a, a2;
+#define INPUT_FMU_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#define INPUT_FMU(name, type, ...) CONTACT_TYPE(type) name;
+#include "parameters.def"
 } bodies;
 
 /* The communication step's side of the coupling: the force outputs, the
@@ -70,47 +72,30 @@ struct fmu_model {
  * of CPU; beyond that a step is a mistake, not a wish. */
 #define MAX_STEPS 1000000000
 
+/* The FMU's rows of parameters.def: an input is a member of in, a
+ * model's parameter of params, the binding's own parameter (coupling) of
+ * fmu_model, and an output is computed (real_output). */
+#define VARIABLE(name, type, causality, offset) {VR_##name, #name, VAR_TYPE_##type, causality, offset},
+#define VAR_TYPE_Real VAR_REAL
+#define VAR_TYPE_Integer VAR_INTEGER
+#define VAR_TYPE_Boolean VAR_BOOLEAN
+#define INPUT(name, type, ...) VARIABLE(name, type, VAR_INPUT, offsetof(fmu_model, in.name))
+#define MODEL_PARAMETER(name, type, ...) VARIABLE(name, type, VAR_PARAMETER, PARAM(name))
+#define OWN_PARAMETER(name, type, ...) VARIABLE(name, type, VAR_PARAMETER, offsetof(fmu_model, name))
+#define OUTPUT(name, type, ...) VARIABLE(name, type, VAR_OUTPUT, 0)
 static const fmu_variable variable_list[] = {
-    {VR_v, "v", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.v)},
-    {VR_m, "m", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.m)},
-    {VR_v2, "v2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.v2)},
-    {VR_m2, "m2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.m2)},
-    {VR_a, "a", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.a)},
-    {VR_a2, "a2", VAR_REAL, VAR_INPUT, offsetof(fmu_model, in.a2)},
-    {VR_R, "R", VAR_REAL, VAR_PARAMETER, PARAM(R)},
-    {VR_E_i, "E_i", VAR_REAL, VAR_PARAMETER, PARAM(E_i)},
-    {VR_nu_i, "nu_i", VAR_REAL, VAR_PARAMETER, PARAM(nu_i)},
-    {VR_E_s, "E_s", VAR_REAL, VAR_PARAMETER, PARAM(E_s)},
-    {VR_nu_s, "nu_s", VAR_REAL, VAR_PARAMETER, PARAM(nu_s)},
-    {VR_k, "k", VAR_REAL, VAR_PARAMETER, PARAM(k)},
-    {VR_spring_exponent, "spring_exponent", VAR_REAL, VAR_PARAMETER, PARAM(spring_exponent)},
-    {VR_c, "c", VAR_REAL, VAR_PARAMETER, PARAM(c)},
-    {VR_damper_order, "damper_order", VAR_REAL, VAR_PARAMETER, PARAM(damper_order)},
-    {VR_c_alpha, "c_alpha", VAR_REAL, VAR_PARAMETER, PARAM(c_alpha)},
-    {VR_memory_tolerance, "memory_tolerance", VAR_REAL, VAR_PARAMETER, PARAM(memory_tolerance)},
-    {VR_tolerance, "tolerance", VAR_REAL, VAR_PARAMETER, PARAM(tolerance)},
-    {VR_dt_max, "dt_max", VAR_REAL, VAR_PARAMETER, PARAM(dt_max)},
-    {VR_g, "g", VAR_REAL, VAR_PARAMETER, PARAM(g)},
-    {VR_gap0, "gap0", VAR_REAL, VAR_PARAMETER, PARAM(gap0)},
-    {VR_F, "F", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_F_avg, "F_avg", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_F_avg_next, "F_avg_next", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_F_peak, "F_peak", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_x, "x", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_x1, "x1", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_x2, "x2", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_v_striker, "v_striker", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_E_diss, "E_diss", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_eps, "eps", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_semi_integral, "semi_integral", VAR_REAL, VAR_OUTPUT, 0},
-    {VR_law, "law", VAR_INTEGER, VAR_PARAMETER, PARAM(law)},
-    {VR_g1_nodes, "g1_nodes", VAR_INTEGER, VAR_PARAMETER, PARAM(g1_nodes)},
-    {VR_scene, "scene", VAR_INTEGER, VAR_PARAMETER, PARAM(scene)},
-    {VR_damper, "damper", VAR_INTEGER, VAR_PARAMETER, PARAM(damper)},
-    {VR_memory, "memory", VAR_INTEGER, VAR_PARAMETER, PARAM(memory)},
-    {VR_coupling, "coupling", VAR_INTEGER, VAR_PARAMETER, offsetof(fmu_model, coupling)},
-    {VR_contact, "contact", VAR_BOOLEAN, VAR_OUTPUT, 0},
+#define INPUT_FMU_LIBRARY INPUT
+#define INPUT_FMU INPUT
+#define PARAMETER_MODEL_FMU_LIBRARY MODEL_PARAMETER
+#define PARAMETER_FMU OWN_PARAMETER
+#define OUTPUT_FMU OUTPUT
+#include "parameters.def"
 };
+#undef VARIABLE
+#undef INPUT
+#undef MODEL_PARAMETER
+#undef OWN_PARAMETER
+#undef OUTPUT
 
 static const fmu_variables variables = {variable_list, sizeof variable_list / sizeof variable_list[0]};
 
@@ -208,8 +193,10 @@ double fm_time(const fmu_model *fm)
 static void start_values(fmu_model *fm)
 {
     contact_default_params(&fm->params);
-    contact_default_striker(&fm->in.v, &fm->in.m);
-    fm->coupling = COUPLING_GAUSS_SEIDEL;
+#define INPUT_FMU_LIBRARY(name, type, unit, value, ...) fm->in.name = value;
+#define INPUT_FMU(name, type, unit, value, ...) fm->in.name = value;
+#define PARAMETER_FMU(name, type, unit, value, ...) fm->name = value;
+#include "parameters.def"
     preview_start(fm);
 }
 

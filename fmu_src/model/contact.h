@@ -91,27 +91,19 @@ enum contact_scene {
     CONTACT_SCENE_DRIVEN = 2  /* the caller prescribes the indentation rate */
 };
 
+/* The C type of a table row's type (parameters.def). */
+#define CONTACT_TYPE_Real double
+#define CONTACT_TYPE_Integer int
+#define CONTACT_TYPE(type) CONTACT_TYPE_##type
+
+/* The model's parameters, a member each (parameters.def says what each
+ * is): the rows of MODEL, the enumerations' codes those of the enums above;
+ * dt_max = 0 means fixed steps of CONTACT_DEFAULT_STEP and no cap on
+ * error-controlled steps (contact_step_limit). */
 typedef struct {
-    double R;            /* striker tip radius [m] */
-    double E_i, nu_i;    /* indenter Young's modulus [Pa] and Poisson ratio */
-    double E_s, nu_s;    /* specimen Young's modulus [Pa] and Poisson ratio */
-    double k;            /* spring constant [N/m^n]; 0: the Hertz constant from the above (n = 1.5) */
-    double spring_exponent; /* n in F = k x1^n, >= 1 */
-    double c;            /* dashpot constant [N s/m] */
-    double damper_order; /* alpha of the springpot, in (0, 1] */
-    double c_alpha;      /* springpot constant [N s^alpha/m] */
-    double memory_tolerance; /* relative error of the compressed memory's kernel */
-    double tolerance;    /* relative error per internal step; 0: fixed steps of dt_max */
-    double dt_max;       /* largest internal step [s]; 0: fixed steps of CONTACT_DEFAULT_STEP, and no
-                            cap on error-controlled steps (contact_step_limit) */
-    double g;            /* acceleration of the model's striker towards the specimen [m/s^2] */
-    double gap0;         /* gap between striker and specimen at the start [m] */
-    int law;             /* enum contact_law */
-    int g1_nodes;        /* G1 intervals N; 0: internal steps since contact onset */
-    int scene;           /* enum contact_scene */
-    int scheme;          /* enum contact_scheme */
-    int damper;          /* enum contact_damper */
-    int memory;          /* enum contact_memory */
+#define PARAMETER_MODEL_FMU_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#define PARAMETER_MODEL_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#include "parameters.def"
 } contact_params;
 
 typedef struct {

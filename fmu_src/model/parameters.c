@@ -12,35 +12,25 @@
 
 void contact_default_params(contact_params *p)
 {
-    p->R = 6.35e-3;
-    p->E_i = 210e9;
-    p->nu_i = 0.3;
-    p->E_s = 2.64e9;
-    p->nu_s = 0.4;
-    p->k = 3.299e8;
-    p->spring_exponent = 1.5;
-    p->c = 6080.0;
-    /* A springpot as damping as the dashpot at the impact's frequency
-     * omega = pi / t_c ~ 2400 rad/s: c_alpha omega^alpha = c omega. */
-    p->damper_order = 0.5;
-    p->c_alpha = 3e5;
-    p->memory_tolerance = 1e-6;
-    p->tolerance = 0.0;
-    p->dt_max = 0.0; /* fixed steps of CONTACT_DEFAULT_STEP; error-controlled ones uncapped */
-    p->g = 0.0;
-    p->gap0 = 0.0;
-    p->law = CONTACT_LAW_G1;
-    p->g1_nodes = 0;
-    p->scene = CONTACT_SCENE_DROP;
-    p->scheme = CONTACT_SCHEME_SDIRK2;
-    p->damper = CONTACT_DAMPER_DASHPOT;
-    p->memory = CONTACT_MEMORY_COMPRESSED;
+#define PARAMETER_MODEL_FMU_LIBRARY(name, type, unit, value, ...) p->name = value;
+#define PARAMETER_MODEL_LIBRARY(name, type, unit, value, ...) p->name = value;
+#include "parameters.def"
 }
+
+/* The defaults of the inputs the library shares with the FMU: the paper's
+ * h20 striker (v = sqrt(2 g h) for its 20 mm drop), no second body. */
+static const struct {
+#define INPUT_FMU_LIBRARY(name, type, ...) CONTACT_TYPE(type) name;
+#include "parameters.def"
+} bodies_default = {
+#define INPUT_FMU_LIBRARY(name, type, unit, value, ...) value,
+#include "parameters.def"
+};
 
 void contact_default_striker(double *v, double *m)
 {
-    *v = 0.626418; /* sqrt(2 g h) for the paper's 20 mm drop */
-    *m = 0.7437;
+    *v = bodies_default.v;
+    *m = bodies_default.m;
 }
 
 double hertz_constant(double R, double E_i, double nu_i, double E_s, double nu_s)

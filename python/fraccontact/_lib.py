@@ -28,7 +28,7 @@ def library_path():
 
 class Parameter(ctypes.Structure):
     _fields_ = [("name", ctypes.c_char_p), ("kind", ctypes.c_int), ("offset", ctypes.c_size_t),
-                ("unit", ctypes.c_char_p), ("help", ctypes.c_char_p)]
+                ("unit", ctypes.c_char_p), ("help", ctypes.c_char_p), ("words", ctypes.c_char_p)]
 
 
 class Impact(ctypes.Structure):
@@ -69,7 +69,7 @@ def _parameter_table():
     for i in range(LIB.fc_parameter_count()):
         p = LIB.fc_parameter_at(i).contents
         table.append(dict(name=p.name.decode(), kind="real" if p.kind == 0 else "integer", offset=p.offset,
-                          unit=p.unit.decode(), help=p.help.decode()))
+                          unit=p.unit.decode(), help=p.help.decode(), words=p.words.decode().split()))
     return table
 
 

@@ -56,9 +56,8 @@ import numpy as np
 
 from . import _lib
 
-WORDS = {"law": {"g1": 1, "hertz": 2, "g1x": 3}, "scene": {"drop": 1, "driven": 2},
-         "scheme": {"sdirk2": 1, "central": 2}, "damper": {"dashpot": 1, "springpot": 2},
-         "memory": {"full": 1, "compressed": 2}}
+# The words an enumerated parameter also takes, {word: code}, from the library's table.
+WORDS = {p["name"]: {word: code for code, word in enumerate(p["words"], 1)} for p in _lib.PARAMETERS if p["words"]}
 IMPACT_FIGURES = ("t_onset", "v_onset", "F_peak", "eps", "t_contact", "x2_end", "E_diss")
 NAMES = tuple(p["name"] for p in _lib.PARAMETERS)
 INTEGERS = frozenset(p["name"] for p in _lib.PARAMETERS if p["kind"] == "integer")

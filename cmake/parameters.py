@@ -1,0 +1,197 @@
+"""The files that fmu_src/model/parameters.def generates outside C: the
+variables and model structure of both modelDescription.xml files and the
+table of docs/variables.md. The parts of those files that no row of the
+table decides (the GUID, the capabilities, the units, the prose) stay as
+written; only the generated sections are replaced.
+
+  parameters.py ROOT OUT        write the generated files into the folder OUT
+  parameters.py ROOT OUT --check  ... and fail naming each file under ROOT that differs
+  parameters.py ROOT ROOT       regenerate the files in the source tree ROOT
+
+The build runs it with --check (CMakeLists.txt, target parameter_files)."""
+
+import argparse
+import html
+import pathlib
+import re
+import sys
+
+TABLE = pathlib.Path("fmu_src/model/parameters.def")
+FMI2, FMI3, PAGE = pathlib.Path("modelDescription.xml"), pathlib.Path("fmi3/modelDescription.xml"), \
+    pathlib.Path("docs/variables.md")
+COLUMNS = ("name", "type", "unit", "default", "min", "max", "vr", "index", "variability", "words", "rule",
+           "description")
+KINDS = ("input", "parameter", "stop", "option", "output")
+PLACES = ("model", "fmu", "library", "solver", "package")
+# The initial unknowns that depend on a variable at the start: x = -gap0, v_striker = v - v2.
+INITIAL_DEPENDENCIES = {"x": ("gap0",), "v_striker": ("v", "v2")}
+ARGUMENT = re.compile(r'\s*((?:"[^"\\]*"\s*)+|[^,"]*?)\s*(,|$)')
+
+
+def arguments(text):
+    """The macro arguments of one row: C string literals (adjacent ones
+    joined) as their text, anything else as written."""
+    values, at = [], 0
+    while at <= len(text):
+        m = ARGUMENT.match(text, at)
+        if not m:
+            raise ValueError(f"cannot read the arguments {text!r} from position {at}")
+        token = m.group(1)
+        values.append("".join(re.findall(r'"([^"]*)"', token)) if token.startswith('"') else token)
+        at = m.end() if m.group(2) else len(text) + 1
+    return values
+
+
+def read_table(path):
+    """The rows of parameters.def as dicts, in its order, with kind and where."""
+    text = re.sub(r"/\*.*?\*/", "", pathlib.Path(path).read_text(), flags=re.S)
+    rows = []
+    for line in text.splitlines():
+        m = re.match(r"([A-Z_]+)\((.*)\)$", line.strip())
+        if not m or line.startswith("#"):
+            continue
+        kind, *where = m.group(1).lower().split("_")
+        values = arguments(m.group(2))
+        if kind not in KINDS or not where or not set(where) <= set(PLACES) or len(values) != len(COLUMNS):
+            raise ValueError(f"{path}: the row {line.strip()[:60]!r} is not KIND_WHERE(...) with {len(COLUMNS)} "
+                             f"arguments ({', '.join(COLUMNS)})")
+        rows.append(dict(zip(COLUMNS, values), kind=kind, where=where))
+    return rows
+
+
+def fmu_rows(rows):
+    """The FMU's variables in the order of modelDescription.xml."""
+    return sorted((r for r in rows if "fmu" in r["where"]), key=lambda r: int(r["index"]))
+
+
+def attributes(row, names):
+    return "".join(f' {name}="{row[key]}"' for name, key in names if row[key])
+
+
+def fmi2_variable(row):
+    type_ = row["type"]
+    value = ("unit", "unit"), ("start", "default"), ("min", "min"), ("max", "max")
+    if type_ != "Real":
+        value = value[1:]
+    return (f'    <!-- {row["index"]} --><ScalarVariable name="{row["name"]}" valueReference="{row["vr"]}" '
+            f'causality="{row["kind"]}" variability="{row["variability"]}"\n'
+            f'      description="{html.escape(row["description"], quote=False)}">\n'
+            f'      <{type_}{attributes(row, value)}/></ScalarVariable>')
+
+
+def initial_comment(by_name, key):
+    """Which initial unknowns depend on what, by their FMI 2.0 indices or FMI 3.0 value references."""
+    parts = [f"{name} = {formula} ({', '.join(by_name[d][key] for d in INITIAL_DEPENDENCIES[name])})"
+             for name, formula in (("x", "-gap0"), ("v_striker", "v - v2"))]
+    return f"at the start: {', '.join(parts)}; the rest starts at 0"
+
+
+def dependencies(row, by_name, key):
+    return " ".join(by_name[d][key] for d in INITIAL_DEPENDENCIES.get(row["name"], ()))
+
+
+def fmi2_section(rows):
+    """From <ModelVariables> to </ModelStructure> of modelDescription.xml."""
+    fmu = fmu_rows(rows)
+    by_name = {r["name"]: r for r in fmu}
+    outputs = [r for r in fmu if r["kind"] == "output"]
+    lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu] + ["  </ModelVariables>", "",
+                                                                           "  <ModelStructure>", "    <Outputs>",
+             "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
+    lines += [f'      <Unknown index="{r["index"]}" dependencies=""/>' for r in outputs]
+    lines += ["    </Outputs>", "    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
+    lines += [f'      <Unknown index="{r["index"]}" dependencies="{dependencies(r, by_name, "index")}"/>'
+              for r in outputs]
+    return "\n".join(lines + ["    </InitialUnknowns>", "  </ModelStructure>"])
+
+
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
+
+
+def fmi3_variable(row):
+    value = ("unit", "unit"), ("start", "default"), ("min", "min"), ("max", "max")
+    if row["type"] != "Real":
+        value = value[1:]
+    return (f'    <{FMI3_TYPES[row["type"]]} name="{row["name"]}" valueReference="{row["vr"]}" '
+            f'causality="{row["kind"]}" variability="{row["variability"]}"{attributes(row, value)}\n'
+            f'      description="{html.escape(row["description"], quote=False)}"/>')
+
+
+def fmi3_section(rows):
+    """From <ModelVariables> to </ModelStructure> of fmi3/modelDescription.xml."""
+    fmu = fmu_rows(rows)
+    by_name = {r["name"]: r for r in fmu}
+    outputs = [r for r in fmu if r["kind"] == "output"]
+    lines = ["  <ModelVariables>",
+             '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous" unit="s"',
+             '      description="simulation time"/>']
+    lines += [fmi3_variable(r) for r in fmu] + ["  </ModelVariables>", "", "  <ModelStructure>",
+                                                "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
+                                                "         mode): no direct feedthrough from the inputs -->"]
+    lines += [f'    <Output valueReference="{r["vr"]}"/>' for r in outputs]
+    lines += [f"    <!-- {initial_comment(by_name, 'vr')} -->"]
+    lines += [f'    <InitialUnknown valueReference="{r["vr"]}" dependencies="{dependencies(r, by_name, "vr")}"/>'
+              for r in outputs]
+    return "\n".join(lines + ["  </ModelStructure>"])
+
+
+def replaced(text, begin, end, section, what):
+    """text with the lines from begin to end (both included) replaced by section."""
+    start, stop = text.find(begin), text.find(end)
+    if start < 0 or stop < start:
+        raise ValueError(f"{what} has no {begin.strip()} ... {end.strip()} section")
+    return text[:start] + section + text[stop + len(end):]
+
+
+def cell(row, column):
+    if column == "name":
+        return f"`{row['name']}`"
+    if column == "where":
+        return " ".join(row["where"])
+    return row[column].replace("|", "\\|")
+
+
+PAGE_COLUMNS = ("name", "kind", "type", "unit", "default", "rule", "vr", "where", "description")
+
+
+def page_section(rows):
+    """The markdown table of docs/variables.md, between its markers."""
+    lines = ["<!-- variables:begin -->", "", "| " + " | ".join(PAGE_COLUMNS) + " |",
+             "|" + "---|" * len(PAGE_COLUMNS)]
+    lines += ["| " + " | ".join(cell(r, c) for c in PAGE_COLUMNS) + " |" for r in rows]
+    return "\n".join(lines + ["", "<!-- variables:end -->"])
+
+
+def generated(root):
+    """{relative path: text} of every file the table generates, from the files under root."""
+    rows = read_table(root / TABLE)
+    return {FMI2: replaced((root / FMI2).read_text(), "  <ModelVariables>", "  </ModelStructure>",
+                           fmi2_section(rows), FMI2),
+            FMI3: replaced((root / FMI3).read_text(), "  <ModelVariables>", "  </ModelStructure>",
+                           fmi3_section(rows), FMI3),
+            PAGE: replaced((root / PAGE).read_text(), "<!-- variables:begin -->", "<!-- variables:end -->",
+                           page_section(rows), PAGE)}
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("root", type=pathlib.Path, help="the source tree")
+    p.add_argument("out", type=pathlib.Path, help="where the generated files go")
+    p.add_argument("--check", action="store_true", help="fail when a file under ROOT differs from its generation")
+    args = p.parse_args(argv)
+    stale = []
+    for path, text in generated(args.root).items():
+        target = args.out / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if not target.exists() or target.read_text() != text:
+            target.write_text(text)
+        if args.check and (args.root / path).read_text() != text:
+            stale.append(path)
+    for path in stale:
+        print(f"{args.root / path} is not what {TABLE} generates ({args.out / path}): run "
+              f"'cmake --build <build> --target update-parameter-files'", file=sys.stderr)
+    return 1 if stale else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
