@@ -154,10 +154,10 @@ MUTANTS = [
            (RADAU, "{0.15906584442746913, 0.0}, {0.13317907701829959",
             "{0.15906584442746913 * (1.0 + 1e-11), 0.0}, {0.13317907701829959")),
     mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update divides the second complex pair's "
-           "term by the wrong pair's modulus",
+           "term by the wrong pair",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage",
-           (RADAU, "m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[2][j]);",
-            "m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[1][j]);")),
+           (RADAU, "(phi * t2r + w2r) * m->radau_d[3][j] + (phi * t2i + w2i) * m->radau_d[4][j];",
+            "(phi * t2r + w2r) * m->radau_d[1][j] + (phi * t2i + w2i) * m->radau_d[2][j];")),
     mutant("radau-kept-reciprocals", "time scheme", "Radau IIA: the modes' update takes the kept reciprocals "
            "whatever trial's step they were built for",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage: the update of a model copied "

@@ -163,7 +163,7 @@ typedef struct {
     double p[CONTACT_MAX_MODES], q[CONTACT_MAX_MODES];      /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
     double keep[CONTACT_MAX_MODES], rate1[CONTACT_MAX_MODES], rate2[CONTACT_MAX_MODES]; /* the update */
     double radau_h; /* the step length of radau_d (0: none yet) */
-    double radau_d[3][CONTACT_MAX_MODES]; /* Radau IIA's 1/(1 + h b lambda_0), 1/|1 + h b lambda_l|^2 */
+    double radau_d[5][CONTACT_MAX_MODES]; /* Radau IIA's 1/(1 + h b lambda_l): lambda_0's, the pairs' re, -im */
 } contact_modes; /* a new field: copy it in contact_copy too */
 
 /* The full G1 history (a springpot with memory = 1): x2 at every step since

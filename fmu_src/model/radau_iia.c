@@ -161,8 +161,10 @@ static void from_blocks(const complex_pair z[BLOCKS], double x[STAGES])
  * needs d_0 d_l too: for l > 0 that is (lambda_0 d_0 - lambda_l d_l) /
  * (lambda_0 - lambda_l), from p_0 and p_l). The three reciprocals by one
  * division of their product, whose size, (h b)^5 at most, stays far from
- * overflowing for any step and mode; the pass keeps them in radau_d (d_0
- * and 1/|1 + h b lambda_l|^2 for the pairs) for the update of the modes. */
+ * overflowing for any step and mode; the pass keeps them in radau_d (d_0,
+ * and for each pair the real part of d_l and minus its imaginary part), so
+ * that the sums of a phi d and the update of the modes need no more than
+ * products with them. */
 typedef struct {
     complex_pair p[BLOCKS], q[BLOCKS];
     double pp0, qq0, relaxed;
@@ -199,33 +201,33 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
             const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
             const double inv = 1.0 / (D0 * (N1 * N2));
             const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
-            const double ad = a * d0, ak1 = a * k1, ak2 = a * k2;
+            const double ad = a * d0, c1r = k1 * u1, c1i = k1 * v1, c2r = k2 * u2, c2i = k2 * v2;
             m->radau_d[0][j + k] = d0;
-            m->radau_d[1][j + k] = k1;
-            m->radau_d[2][j + k] = k2;
+            m->radau_d[1][j + k] = c1r;
+            m->radau_d[2][j + k] = c1i;
+            m->radau_d[3][j + k] = c2r;
+            m->radau_d[4][j + k] = c2i;
             lane[SUM_Q0][k] += ad;
             lane[SUM_QQ0][k] += ad * d0;
-            lane[SUM_Q1R][k] += ak1 * u1;
-            lane[SUM_Q1I][k] -= ak1 * v1;
-            lane[SUM_Q2R][k] += ak2 * u2;
-            lane[SUM_Q2I][k] -= ak2 * v2;
+            lane[SUM_Q1R][k] += a * c1r;
+            lane[SUM_Q1I][k] -= a * c1i;
+            lane[SUM_Q2R][k] += a * c2r;
+            lane[SUM_Q2I][k] -= a * c2i;
         }
     }
     for (j = first; j < m->modes; j += CONTACT_MODE_LANES) { /* the sums of a phi d, from the reciprocals */
 #pragma omp simd
         for (k = 0; k < width; k++) {
             const double x = h * m->b[j + k], ap = m->a[j + k] * m->phi[j + k];
-            const double u1 = 1.0 + x * r1, v1 = x * i1;
-            const double u2 = 1.0 + x * r2, v2 = x * i2;
             const double d0 = m->radau_d[0][j + k];
-            const double apd = ap * d0, apk1 = ap * m->radau_d[1][j + k], apk2 = ap * m->radau_d[2][j + k];
+            const double apd = ap * d0;
             lane[SUM_RELAXED][k] += apd * (x * l0);
             lane[SUM_P0][k] += apd;
             lane[SUM_PP0][k] += apd * d0;
-            lane[SUM_P1R][k] += apk1 * u1;
-            lane[SUM_P1I][k] -= apk1 * v1;
-            lane[SUM_P2R][k] += apk2 * u2;
-            lane[SUM_P2I][k] -= apk2 * v2;
+            lane[SUM_P1R][k] += ap * m->radau_d[1][j + k];
+            lane[SUM_P1I][k] -= ap * m->radau_d[2][j + k];
+            lane[SUM_P2R][k] += ap * m->radau_d[3][j + k];
+            lane[SUM_P2I][k] -= ap * m->radau_d[4][j + k];
         }
     }
     for (n = 0; n < SUMS; n++)
@@ -486,30 +488,26 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
 
 /* Each mode to the last stage's value, elementwise from the reciprocals the
  * trial's pass kept: any vector width gives the same bits. */
-static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, double h, const complex_pair tau[BLOCKS],
+static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, const complex_pair tau[BLOCKS],
                                                       const complex_pair tau_W[BLOCKS])
 {
-    const double r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
-    const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
     const double t0 = tau[0].re, t1r = tau[1].re, t1i = tau[1].im, t2r = tau[2].re, t2i = tau[2].im;
     const double w0 = tau_W[0].re, w1r = tau_W[1].re, w1i = tau_W[1].im, w2r = tau_W[2].re, w2i = tau_W[2].im;
     size_t j;
 #pragma omp simd
     for (j = 0; j < m->modes; j++) {
-        const double x = h * m->b[j], phi = m->phi[j];
-        const double u1 = 1.0 + x * r1, v1 = x * i1;
-        const double u2 = 1.0 + x * r2, v2 = x * i2;
-        /* Re(tau (phi + W) / s) = Re(tau (phi + W) conj(s)) / |s|^2 for s = 1 + x lambda */
+        /* Re(tau (phi + W) d) coordinate by coordinate */
+        const double phi = m->phi[j];
         const double n0 = phi * t0 + w0;
-        const double n1 = (phi * t1r + w1r) * u1 + (phi * t1i + w1i) * v1;
-        const double n2 = (phi * t2r + w2r) * u2 + (phi * t2i + w2i) * v2;
-        m->phi[j] = n0 * m->radau_d[0][j] + (n1 * m->radau_d[1][j] + n2 * m->radau_d[2][j]);
+        const double n1 = (phi * t1r + w1r) * m->radau_d[1][j] + (phi * t1i + w1i) * m->radau_d[2][j];
+        const double n2 = (phi * t2r + w2r) * m->radau_d[3][j] + (phi * t2i + w2i) * m->radau_d[4][j];
+        m->phi[j] = n0 * m->radau_d[0][j] + (n1 + n2);
     }
 }
 
 CPU_VERSIONS(modes_to_last_stage,
-             (contact_modes * m, double h, const complex_pair tau[BLOCKS], const complex_pair tau_W[BLOCKS]),
-             (m, h, tau, tau_W))
+             (contact_modes * m, const complex_pair tau[BLOCKS], const complex_pair tau_W[BLOCKS]),
+             (m, tau, tau_W))
 
 /* The modes after an accepted step: the last stage's (stiffly accurate),
  * Phi = (I + h b A)^-1 (phi_n 1 + h A Z) in the coordinates, from the
@@ -533,7 +531,7 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
         tau[l] = coordinate_weight(radau_t[STAGES - 1], l);
         tau_W[l] = times(tau[l], times(h_lambda(h, l), Zt[l]));
     }
-    CPU_VERSION(modes_to_last_stage, (m, h, tau, tau_W));
+    CPU_VERSION(modes_to_last_stage, (m, tau, tau_W));
 }
 
 /* The dense output: the polynomial through (theta_i, y_i) at the nodes

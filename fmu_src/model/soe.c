@@ -48,13 +48,9 @@ static void fast_tail(double alpha, double lg_alpha, double x, double *value, do
  * function of x, in which both bounds are nearly straight lines (a few
  * steps from hi, where in ln x they are exponentials), kept inside the
  * bracket in ln x (a step leaving it bisects it), to rounding. */
-static double decreasing_below(log_bound f, double alpha, double target, double lo, double hi)
+static double decreasing_below(log_bound f, double alpha, double lg_alpha, double target, double lo, double hi)
 {
-    /* ln Gamma(alpha) from Gamma(alpha) = Gamma(1 + alpha) / alpha: lgamma
-     * would write the global signgam, a data race between threads building
-     * kernels at once, and tgamma(alpha) itself overflows for alpha below
-     * 1 / DBL_MAX, where Gamma(1 + alpha) is still near 1. */
-    const double lg_alpha = log(tgamma(1.0 + alpha)) - log(alpha), goal = log(target);
+    const double goal = log(target);
     double a = log(lo), b = log(hi), s, value, slope;
     int i;
     f(alpha, lg_alpha, lo, &value, &slope);
@@ -91,18 +87,23 @@ size_t soe_kernel(double alpha, double tolerance, double delta, double span, siz
                   double *eta)
 {
     const double part = tolerance / 4.0;
-    double du, weight, u_max, u_min, u, ratio, step_a, step_b;
+    double lg_alpha, du, weight, u_max, u_min, u, ratio, step_a, step_b;
     size_t n = 0;
     if (alpha >= 1.0) { /* the dashpot: a delta function */
         *eta = 1.0;
         return 0;
     }
+    /* ln Gamma(alpha) from Gamma(alpha) = Gamma(1 + alpha) / alpha: lgamma
+     * would write the global signgam, a data race between threads building
+     * kernels at once, and tgamma(alpha) itself overflows for alpha below
+     * 1 / DBL_MAX, where Gamma(1 + alpha) is still near 1. */
+    lg_alpha = log(tgamma(1.0 + alpha)) - log(alpha);
     /* y >= 1 (du <= 2 pi) and x >= 1 even where a tiny alpha's huge
      * Gamma(alpha) would allow less: the rule still needs a few points a
      * decade, and the fast cut must lie above 1/delta. */
-    du = 2.0 * PI / decreasing_below(aliasing_error, alpha, part, 1.0, 1e4);
+    du = 2.0 * PI / decreasing_below(aliasing_error, alpha, lg_alpha, part, 1.0, 1e4);
     weight = sin(PI * alpha) / PI * du;
-    u_max = log(decreasing_below(fast_tail, alpha, part, 1.0, 1e4) / delta);
+    u_max = log(decreasing_below(fast_tail, alpha, lg_alpha, part, 1.0, 1e4) / delta);
     u_min = log(pow(part * (1.0 + alpha) * tgamma(alpha), 1.0 / (1.0 + alpha)) / span);
     /* The lumped dashpot: the rule's terms above u_max, sum_j a_j / b_j. */
     ratio = exp((alpha - 1.0) * du);
@@ -121,8 +122,7 @@ size_t soe_kernel(double alpha, double tolerance, double delta, double span, siz
     /* The lumped spring: the rule's terms below the slowest one kept. */
     if (n == max)
         return max + 1;
-    ratio = exp(-alpha * du);
-    a[n] = weight * exp(alpha * (u + du)) * ratio / (1.0 - ratio);
+    a[n] = weight * exp(alpha * (u + du)) * step_a / (1.0 - step_a);
     b[n] = 0.0;
     return n + 1;
 }
