@@ -1,4 +1,4 @@
-"""The files that fmu_src/model/parameters.def generates outside C: the
+"""The files that model/parameters.def generates outside C: the
 variables and model structure of both modelDescription.xml files and the
 table of docs/variables.md. The parts of those files that no row of the
 table decides (the GUID, the capabilities, the units, the prose) stay as
@@ -16,7 +16,7 @@ import pathlib
 import re
 import sys
 
-TABLE = pathlib.Path("fmu_src/model/parameters.def")
+TABLE = pathlib.Path("model/parameters.def")
 FMI2, FMI3, PAGE = pathlib.Path("modelDescription.xml"), pathlib.Path("fmi3/modelDescription.xml"), \
     pathlib.Path("docs/variables.md")
 COLUMNS = ("name", "type", "unit", "default", "min", "max", "vr", "index", "variability", "words", "rule",

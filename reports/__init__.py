@@ -18,7 +18,7 @@ def source_tree():
     they build and test copies of it): the current folder, which
     scripts/report makes the repository's root."""
     root = pathlib.Path.cwd()
-    if not (root / "CMakeLists.txt").exists() or not (root / "fmu_src").is_dir():
+    if not (root / "CMakeLists.txt").exists() or not (root / "model").is_dir():
         raise SystemExit(f"{root} is not the fraccontact repository: run this report from its root (scripts/report does)")
     return root
 

@@ -339,7 +339,7 @@ def precision_rows(root, program, bench, fmu_file):
         say("  the FMU, one doStep over the h20 impact ...")
         fmu_cpu = fmu_one_step(fmu_file, cases[0])
     return dict(head=git(root, "rev-parse", "--short", "HEAD"),
-                dirty=bool(git(root, "status", "--porcelain", "--", "fmu_src", "solver", "CMakeLists.txt")),
+                dirty=bool(git(root, "status", "--porcelain", "--", "model", "fmu_src", "solver", "CMakeLists.txt")),
                 load=load.samples, cases={c["name"]: c for c in cases}, results=results, fmu=fmu_cpu,
                 minutes=(time.perf_counter() - started) / 60)
 
@@ -454,7 +454,7 @@ def precision_section(r):
     out = [PRECISION_BEGIN, "## Work against precision on all four figures", "",
            "Regenerate this section alone, in place: `scripts/report benchmarks --only precision` (this run: "
            f"{r['minutes']:.1f} minutes). Measured side by side in one run on commit {r['head']}"
-           + (" (with uncommitted changes to fmu_src/, solver/ or CMakeLists.txt in the working tree)"
+           + (" (with uncommitted changes to model/, fmu_src/, solver/ or CMakeLists.txt in the working tree)"
               if r["dirty"] else "")
            + f", on {platform.processor() or platform.machine()} ({platform.system()}, {os.cpu_count()} cores "
            f"shared with other work: 1-minute load average {min(load):.2f} to {max(load):.2f}, median "
@@ -820,7 +820,10 @@ def model_sizes(tree):
         exe = os.path.join(folder, "sizes")
         source = ('#include <stdio.h>\n#include "contact.h"\nint main(void) { printf("%zu %zu\\n", '
                   'sizeof(contact_model), sizeof(contact_state)); return 0; }\n')
-        done = subprocess.run([cc, "-I", str(pathlib.Path(tree) / "fmu_src" / "model"), "-x", "c", "-", "-o", exe],
+        # The model's folder: at the top level, or under fmu_src in commits before it moved.
+        include = next(d for d in (pathlib.Path(tree) / "model", pathlib.Path(tree) / "fmu_src" / "model")
+                       if (d / "contact.h").exists())
+        done = subprocess.run([cc, "-I", str(include), "-x", "c", "-", "-o", exe],
                               input=source, capture_output=True, text=True)
         if done.returncode != 0:
             return None
@@ -892,7 +895,7 @@ def resting_state_sizes(path):
 def springpot_rows(root, bench, fmu_file, largest):
     started = time.perf_counter()
     head = git(root, "rev-parse", "--short", "HEAD")
-    dirty = bool(git(root, "status", "--porcelain", "--", "fmu_src", "solver", "CMakeLists.txt"))
+    dirty = bool(git(root, "status", "--porcelain", "--", "model", "fmu_src", "solver", "CMakeLists.txt"))
     with LoadWatch() as load:
         say(f"  building {BASE} in a temporary git worktree ...")
         with base_build(root, BASE) as base:
@@ -933,7 +936,7 @@ def springpot_section(r):
            "Regenerate this section alone, in place: `scripts/report benchmarks --only springpot` (this run: "
            f"{r['minutes']:.1f} minutes, most of it the full history's N = {sp['ladder'][-1]['N']:,.0f} run). "
            f"Measured side by side in one run on commit {r['head']}"
-           + (" (with uncommitted changes to fmu_src/, solver/ or CMakeLists.txt in the working tree)"
+           + (" (with uncommitted changes to model/, fmu_src/, solver/ or CMakeLists.txt in the working tree)"
               if r["dirty"] else "")
            + f", on {platform.processor() or platform.machine()} ({platform.system()}, {os.cpu_count()} cores "
            f"shared with other work: 1-minute load average {min(load):.2f} to {max(load):.2f}, median "

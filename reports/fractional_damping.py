@@ -735,7 +735,7 @@ def section_recovery(rec, sens, sc):
               "on the power law (the contact's length still matters); by 1 s it is.", "",
               "What sets that error: the recovery's own time steps. Out of contact a recovering springpot steps at "
               "a fraction f = 64 dt_max / t_contact (at most 1/16) of the time since separation (RECOVERY_STEPS in "
-              "fmu_src/model/control.c), so that the recovery's O(f^2) error falls with dt_max like the contact's; x2 at 100 s "
+              "model/control.c), so that the recovery's O(f^2) error falls with dt_max like the contact's; x2 at 100 s "
               "against the exact convolution of each run's own force (alpha 0.5, c_alpha 3e5):", "", "| memory_tolerance | dt_max [s] | contact steps | recovery steps to 100 s | "
               "x2 / (I^alpha F / c_alpha) - 1 at 100 s |", "|---|---|---|---|---|"]
     for r in sens:

@@ -70,11 +70,11 @@ def mutant(name, category, change, claim, *edits):
 
 
 G1, MODEL, STATE, INSTANCE = \
-    "fmu_src/model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
-# The model's files (fmu_src/model/): one responsibility each.
-PARAMETERS, LIFE, STAGE, SDIRK2, RADAU, EVENTS, EVOLVE, PASSIVITY = ("fmu_src/model/" + f for f in (
+    "model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
+# The model's files (model/): one responsibility each.
+PARAMETERS, LIFE, STAGE, SDIRK2, RADAU, EVENTS, EVOLVE, PASSIVITY = ("model/" + f for f in (
     "parameters.c", "model.c", "stage.h", "sdirk2.c", "radau_iia.c", "events.c", "evolve.c", "passivity.c"))
-CONTACT_H = "fmu_src/model/contact.h"
+CONTACT_H = "model/contact.h"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
 

@@ -24,8 +24,8 @@ from . import BAR, source_tree
 
 ROOT = source_tree()
 FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",
-               "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "fmu_src/model/g1.c"] + [
-    f"fmu_src/model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
+               "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "model/g1.c"] + [
+    f"model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
                                            "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central",
                                            "passivity")]
 
@@ -79,7 +79,7 @@ def fuzz(seconds):
     out.mkdir(exist_ok=True)
     headers = sh(ROOT / ".venv/bin/python", "-c",
                  "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))").stdout.strip()
-    sh("clang", "-O1", "-fprofile-instr-generate", "-fcoverage-mapping", "-Ifmu_src/model", "-Ifmu_src/glue",
+    sh("clang", "-O1", "-fprofile-instr-generate", "-fcoverage-mapping", "-Imodel", "-Ifmu_src/glue",
        "-Ifmu_src/binding", f"-I{headers}",
        "-Ibuild/generated/fraccontact", "tests/fuzz_replay.c", "tests/fuzz_fmi2.c", *FMU_SOURCES, "-lm",
        "-o", out / "replay")

@@ -1,6 +1,6 @@
 """Every reference in the repository points inside it: a path a comment, a
 docstring, a --help text or a page names (docs/x.md, scripts/x, python/...,
-tests/..., solver/..., fmu_src/..., a .py file given with its directory) is
+tests/..., solver/..., model/..., fmu_src/..., a .py file given with its directory) is
 a file or folder the repository has; a "docs/model.md §n" is one of the
 sections docs/model.md has; and nothing refers to the specification given
 beside the clone (its folder or its two files, by the names OUTSIDE below
@@ -18,7 +18,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SUFFIXES = (".c", ".h", ".py", ".md", ".xml", ".cmake", ".ssd", ".ssv", ".toml")
 # Folders of the repository a path may start with (build/ holds what the
 # build makes, not sources, and is not checked).
-TOP = ("docs", "scripts", "python", "reports", "tests", "solver", "fmu_src", "ssp", "striker", "fmi3", "cmake")
+TOP = ("docs", "scripts", "python", "reports", "tests", "solver", "model", "fmu_src", "ssp", "striker", "fmi3", "cmake")
 PATH = re.compile(r"(?<![\w./~$-])((?:%s)/[\w./*\[\]${}-]*)" % "|".join(TOP))
 # A .py file named with a folder but not from the top (fraccontact/cosim.py,
 # reports/stability.py): some file of the repository must end so.
@@ -95,7 +95,7 @@ def test_every_model_section_cited_exists():
 
 
 @pytest.mark.parametrize("line, bad", [("see scripts/stability.py", True), ("see docs/nothing.md", True),
-                                       ("tests/test_*.c", False), ("fmu_src/model/g1.[ch]", False),
+                                       ("tests/test_*.c", False), ("model/g1.[ch]", False),
                                        ("reports/gone.py", True), ("fraccontact/cosim.py", False),
                                        ("[docs/model.md](model.md)", False), ("[docs/gone.md](gone.md)", True)])
 def test_the_scan_finds_what_it_should(line, bad):

@@ -78,7 +78,7 @@ LAWS = ("g1", "hertz", ADAPTIVE)
 # C2 (dt/T)^2: every accepted step's embedded error estimate is below
 # `tolerance` relative to the elastic indentation L (the larger of x1 and
 # x1 at the contact's peak force) for x1 and x2 and relative to the speed S
-# (the larger of |v| and v_onset) for v (fmu_src/model/esdirk54.c,
+# (the larger of |v| and v_onset) for v (model/esdirk54.c,
 # esdirk_step), and the separation is located to a tenth of the tolerance
 # of the contact time. The 5th-order solution is propagated, whose local
 # error is below the 4th-order estimate's, and over an impact (at most half

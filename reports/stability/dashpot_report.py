@@ -172,7 +172,7 @@ def section(study, rows):
     if failed:
         out += ["## Failures", "",
                 "Every failure below fails a check that holds in the model at any step; none is widened to "
-                "pass. Those marked *known finding* are two properties of the time scheme (fmu_src/model/sdirk2.c), "
+                "pass. Those marked *known finding* are two properties of the time scheme (model/sdirk2.c), "
                 "listed in `KNOWN` in reports/stability/dashpot.py so that a fix, or a new failure, "
                 "stops the script:", ""]
         out += [f"- **{c}**: {FINDINGS[c]}" for c in FINDINGS] + [""]

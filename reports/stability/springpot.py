@@ -123,7 +123,7 @@ def parameters(case, memory, dt, t_end):
 @functools.lru_cache(maxsize=None)
 def lumped_moment(alpha, tolerance, dt):
     """mu = sum a_j / b_j^2 over the exponentials that memory 2's kernel
-    (fmu_src/model/soe.c) lumps into its dashpot: the rates above the
+    (model/soe.c) lumps into its dashpot: the rates above the
     fastest one kept, on the same geometric grid (b_0 e^(k du), weights
     a_0 e^(alpha k du), k >= 1). The lumped dashpot keeps their integral
     (sum a_j/b_j) but drops this first moment, whose part of D^alpha x2 is

@@ -27,7 +27,7 @@ FINDINGS = {
 # Non-failing: the compressed memory's order (built into springpot.K2's form).
 ORDER_FINDING = (
     "**The compressed memory converges at the order 2 - alpha, not 2**, where its kernel's lumped part "
-    "dominates (alpha from about 0.7 to just below 1). Its kernel (fmu_src/model/soe.c) keeps the exponentials "
+    "dominates (alpha from about 0.7 to just below 1). Its kernel (model/soe.c) keeps the exponentials "
     "whose rates lie below about 15/dt_max and lumps the faster ones into a dashpot with the same integral "
     "sum a_j/b_j, which drops their first moment mu = sum a_j/b_j^2 ~ sin(pi alpha) dt_max^(2 - alpha): "
     "D^alpha x2 errs by -mu x2''. At alpha = 0.9 (h20, law hertz) memory 2's E_diss error over "
