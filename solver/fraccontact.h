@@ -50,7 +50,7 @@ typedef enum {
 #define FC_MESSAGE_SIZE 512
 
 /* The FMU's variables by their names, and the run's stop conditions: the
- * library's rows of fmu_src/model/parameters.def, which says what each is
+ * library's rows of model/parameters.def, which says what each is
  * (fc_parameter_at tells them at run time). The model's parameters are the
  * member model (p.model.c, p.model.dt_max). */
 typedef struct {

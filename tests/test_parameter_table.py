@@ -1,4 +1,4 @@
-"""fmu_src/model/parameters.def is the one table of the model's variables.
+"""model/parameters.def is the one table of the model's variables.
 The C preprocessor expands it into the structs, the library's table and the
 FMU's variables; cmake/parameters.py reads it on its own to render both
 modelDescription.xml files and docs/variables.md. The two readings are

@@ -1,4 +1,4 @@
-"""Whether fixed steps resolve an impact (fmu_src/model/resolution.c): a
+"""Whether fixed steps resolve an impact (model/resolution.c): a
 striker too small for the fixed step of 1e-7 s has its steps refined in
 contact (against GSL's reference, with no energy created, the same in the
 library, the solver and the FMU), and a uniform grid that cannot shorten
