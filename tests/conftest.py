@@ -3,6 +3,7 @@
 import os
 import pathlib
 import shutil
+import signal
 
 import pytest
 from fmpy import extract, read_model_description
@@ -11,6 +12,14 @@ from fmu_driver import Slave
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 FMU = pathlib.Path(os.environ.get("FRACCONTACT_FMU", ROOT / "build" / "fraccontact.fmu"))
+
+
+def pytest_configure(config):
+    """A shell's background job ignores SIGINT, and its children inherit that:
+    the suite run so would find no child stopping at the Ctrl-C its tests send.
+    (Set before pytest-xdist starts its workers, which inherit it.)"""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")
