@@ -51,6 +51,7 @@ import differint.differint as differint
 
 from fraccontact import atomic, fit, fmu, model, output, solver
 from fraccontact.scipy_contact import solve_drop
+from reports import source_tree
 
 plt = output.pyplot()
 

@@ -20,6 +20,7 @@ from tqdm import tqdm
 
 from fraccontact import atomic, model, output, solver
 from fraccontact.scipy_contact import solve_drop
+from reports import BAR
 
 plt = output.pyplot()
 
