@@ -575,6 +575,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     double impulse, part, t_start, end, v_end;
     const fmu_variable *overflow;
     const step_account saved = fm->step; /* as it was, for a refusal */
+    const int held = fm->held;             /* the discrete outputs a refusal keeps showing */
     const int stop = (options & FM_STOP_AT_EVENT) != 0, resume = (options & FM_CONTINUE) != 0;
     const unsigned stop_at = stop ? CONTACT_ONSET | CONTACT_SEPARATION : 0u;
     /* a step of the energy account: the master's whole step (an early
@@ -614,6 +615,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     }
     if (isnan(impulse)) {
         fm->step = saved;
+        fm->held = held;
         fm->next.valid = 0;
         if (cm->exceeded)
             return report(fm, FM_ERROR, "logStatusError",
