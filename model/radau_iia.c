@@ -186,6 +186,7 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
 {
     const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
+    double *const radau_d[5] = RADAU_RECIPROCALS(m);
     double lane[SUMS][CONTACT_MODE_LANES];
     size_t j;
     int k, n;
@@ -202,11 +203,11 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
             const double inv = 1.0 / (D0 * (N1 * N2));
             const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
             const double ad = a * d0, c1r = k1 * u1, c1i = k1 * v1, c2r = k2 * u2, c2i = k2 * v2;
-            m->radau_d[0][j + k] = d0;
-            m->radau_d[1][j + k] = c1r;
-            m->radau_d[2][j + k] = c1i;
-            m->radau_d[3][j + k] = c2r;
-            m->radau_d[4][j + k] = c2i;
+            radau_d[0][j + k] = d0;
+            radau_d[1][j + k] = c1r;
+            radau_d[2][j + k] = c1i;
+            radau_d[3][j + k] = c2r;
+            radau_d[4][j + k] = c2i;
             lane[SUM_Q0][k] += ad;
             lane[SUM_QQ0][k] += ad * d0;
             lane[SUM_Q1R][k] += a * c1r;
@@ -219,15 +220,15 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
 #pragma omp simd
         for (k = 0; k < width; k++) {
             const double x = h * m->b[j + k], ap = m->a[j + k] * m->phi[j + k];
-            const double d0 = m->radau_d[0][j + k];
+            const double d0 = radau_d[0][j + k];
             const double apd = ap * d0;
             lane[SUM_RELAXED][k] += apd * (x * l0);
             lane[SUM_P0][k] += apd;
             lane[SUM_PP0][k] += apd * d0;
-            lane[SUM_P1R][k] += ap * m->radau_d[1][j + k];
-            lane[SUM_P1I][k] -= ap * m->radau_d[2][j + k];
-            lane[SUM_P2R][k] += ap * m->radau_d[3][j + k];
-            lane[SUM_P2I][k] -= ap * m->radau_d[4][j + k];
+            lane[SUM_P1R][k] += ap * radau_d[1][j + k];
+            lane[SUM_P1I][k] -= ap * radau_d[2][j + k];
+            lane[SUM_P2R][k] += ap * radau_d[3][j + k];
+            lane[SUM_P2I][k] -= ap * radau_d[4][j + k];
         }
     }
     for (n = 0; n < SUMS; n++)
@@ -493,15 +494,16 @@ static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, const com
 {
     const double t0 = tau[0].re, t1r = tau[1].re, t1i = tau[1].im, t2r = tau[2].re, t2i = tau[2].im;
     const double w0 = tau_W[0].re, w1r = tau_W[1].re, w1i = tau_W[1].im, w2r = tau_W[2].re, w2i = tau_W[2].im;
+    const double *const radau_d[5] = RADAU_RECIPROCALS(m);
     size_t j;
 #pragma omp simd
     for (j = 0; j < m->modes; j++) {
         /* Re(tau (phi + W) d) coordinate by coordinate */
         const double phi = m->phi[j];
         const double n0 = phi * t0 + w0;
-        const double n1 = (phi * t1r + w1r) * m->radau_d[1][j] + (phi * t1i + w1i) * m->radau_d[2][j];
-        const double n2 = (phi * t2r + w2r) * m->radau_d[3][j] + (phi * t2i + w2i) * m->radau_d[4][j];
-        m->phi[j] = n0 * m->radau_d[0][j] + (n1 + n2);
+        const double n1 = (phi * t1r + w1r) * radau_d[1][j] + (phi * t1i + w1i) * radau_d[2][j];
+        const double n2 = (phi * t2r + w2r) * radau_d[3][j] + (phi * t2i + w2i) * radau_d[4][j];
+        m->phi[j] = n0 * radau_d[0][j] + (n1 + n2);
     }
 }
 
