@@ -167,7 +167,7 @@ typedef struct {
     double *p, *q;                /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
     double *keep, *rate1, *rate2; /* the update */
     double radau_h; /* the step length of radau_d (0: none yet) */
-    double *radau_d; /* Radau IIA's 1/(1 + h b lambda_l), five arrays (RADAU_RECIPROCALS): lambda_0's, the pairs' re, -im */
+    double *radau_d; /* Radau IIA's 1/(1 + h b lambda_l), five arrays (RADAU_RECIPROCAL): lambda_0's, the pairs' re, -im */
 } contact_modes; /* a new field: copy it in contact_copy too */
 
 /* The full G1 history (a springpot with memory = 1): x2 at every step since

@@ -138,12 +138,9 @@ static inline double spring_force(const contact_model *cm, double K, double x1)
  * a divisor of CONTACT_MAX_MODES. */
 #define CONTACT_MODE_LANES 8
 
-/* The compressed memory's five arrays of Radau IIA's reciprocals, one
- * after another in its block (contact.h), as an initializer of five
- * pointers. */
-#define RADAU_RECIPROCALS(m)                                                                             \
-    {(m)->radau_d, (m)->radau_d + (m)->room, (m)->radau_d + 2 * (m)->room, (m)->radau_d + 3 * (m)->room, \
-     (m)->radau_d + 4 * (m)->room}
+/* The l-th of the compressed memory's five arrays of Radau IIA's
+ * reciprocals, one after another in its block (contact.h). */
+#define RADAU_RECIPROCAL(m, l) ((m)->radau_d + (l) * (m)->room)
 
 /* contact_spring_stiffness, inline for the steps that take it every time. */
 static inline double spring_stiffness(const contact_model *cm, long n_steps)

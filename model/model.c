@@ -31,15 +31,17 @@ static int kernel_fits(const contact_kernel *k, const contact_params *p)
 #define MODE_ARRAYS 13
 
 /* The block's arrays for `modes` modes, padded to whole lanes: the block
- * kept where it holds them, a zeroed new one replacing it otherwise. 0, or
- * -1 when memory runs out (the block as it was). */
+ * kept where it holds them, a new one replacing it otherwise, its values
+ * unset (whoever takes it sets what a step reads: modes_at_rest,
+ * pad_modes, contact_copy). 0, or -1 when memory runs out (the block as it
+ * was). */
 static int reserve_modes(contact_modes *m, size_t modes)
 {
     const size_t room = (modes + CONTACT_MODE_LANES - 1) / CONTACT_MODE_LANES * CONTACT_MODE_LANES;
     double *block;
     if (room <= m->room)
         return 0;
-    block = calloc(MODE_ARRAYS * room, sizeof *block);
+    block = malloc(MODE_ARRAYS * room * sizeof *block);
     if (!block)
         return -1;
     free(m->a);
@@ -111,9 +113,31 @@ static int configure(contact_model *cm, const contact_params *p, contact_kernel 
     return 0;
 }
 
+/* The memory at rest (pad_modes zeroed the padding), and the coefficients
+ * of no step length zero as in a model cleared whole: modes.h = 0 names
+ * none, but a step of length 0 (a flight that touches at once) reads them
+ * as they are. */
+static void modes_at_rest(contact_modes *m)
+{
+    const size_t bytes = m->modes * sizeof m->phi[0];
+    if (!m->modes)
+        return;
+    memset(m->phi, 0, bytes);
+    memset(m->p, 0, bytes);
+    memset(m->q, 0, bytes);
+    memset(m->keep, 0, bytes);
+    memset(m->rate1, 0, bytes);
+    memset(m->rate2, 0, bytes);
+}
+
 int contact_configure(contact_model *cm, const contact_params *p)
 {
-    return configure(cm, p, NULL);
+    const double *block = cm->modes.a;
+    if (configure(cm, p, NULL) != 0)
+        return -1;
+    if (cm->modes.a != block) /* a new block: the coefficients too at rest */
+        modes_at_rest(&cm->modes);
+    return 0;
 }
 
 void contact_release_modes(contact_model *cm)
@@ -136,27 +160,14 @@ int contact_start(contact_model *cm, const contact_params *p, double v0, double 
 }
 
 /* Clears a model, its memory none (configure allocates the compressed
- * memory's block, zeroed). */
+ * memory's block): the fields before the modes as one, the modes' and the
+ * history's one by one. */
 static void clear_model(contact_model *cm)
 {
-    memset(cm, 0, sizeof *cm);
-}
-
-/* The memory at rest (pad_modes zeroed the padding), and the coefficients
- * of no step length zero as in a model cleared whole: modes.h = 0 names
- * none, but a step of length 0 (a flight that touches at once) reads them
- * as they are. */
-static void modes_at_rest(contact_modes *m)
-{
-    const size_t bytes = m->modes * sizeof m->phi[0];
-    if (!m->modes)
-        return;
-    memset(m->phi, 0, bytes);
-    memset(m->p, 0, bytes);
-    memset(m->q, 0, bytes);
-    memset(m->keep, 0, bytes);
-    memset(m->rate1, 0, bytes);
-    memset(m->rate2, 0, bytes);
+    static const contact_modes no_modes;
+    memset(cm, 0, offsetof(contact_model, modes));
+    cm->modes = no_modes;
+    memset(&cm->history, 0, sizeof cm->history);
 }
 
 int contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)

@@ -475,6 +475,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
                      contact_kernel *kernel, fc_outcome *o, char *msg, size_t len)
 {
     const contact_params *q = &p->model;
+    static const contact_modes no_modes;
     contact_model cm;
     row_copies copies;
     double E_diss_onset = 0.0;
@@ -486,7 +487,7 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         return o->status = FC_EINVAL;
     fc_striker(p, &v, &m);
     dt = contact_step_limit(q);
-    memset(&copies, 0, sizeof copies);
+    copies.snapshot.modes = copies.cursor.modes = copies.at.modes = no_modes;
     if (contact_start_with(&cm, q, v, m, kernel) != 0 || contact_copy_room(&copies.snapshot, &cm) != 0
         || contact_copy_room(&copies.cursor, &cm) != 0 || contact_copy_room(&copies.at, &cm) != 0) {
         contact_reject(msg, len, "memory", (double)q->memory, "out of memory for the springpot's modes");
