@@ -346,6 +346,14 @@ typedef struct {
     contact_model snapshot, cursor, at;
 } row_copies;
 
+/* Room in the copies for the modes of *cm: 0, or -1 when memory runs out. */
+static int row_copies_room(row_copies *c, const contact_model *cm)
+{
+    if (contact_copy_room(&c->snapshot, cm) != 0 || contact_copy_room(&c->cursor, cm) != 0)
+        return -1;
+    return contact_copy_room(&c->at, cm);
+}
+
 /* Rows at the output times k * interval in (from->s.t, t], each the model
  * advanced to that time from a copy of the state, so that what the rows
  * show never changes the steps the run takes. The copy is the last state
@@ -488,14 +496,14 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
     fc_striker(p, &v, &m);
     dt = contact_step_limit(q);
     copies.snapshot.modes = copies.cursor.modes = copies.at.modes = no_modes;
-    if (contact_start_with(&cm, q, v, m, kernel) != 0 || contact_copy_room(&copies.snapshot, &cm) != 0
-        || contact_copy_room(&copies.cursor, &cm) != 0 || contact_copy_room(&copies.at, &cm) != 0) {
+    uniform = contact_steps_uniformly(q);
+    grid = rows_on_grid(q);
+    if (contact_start_with(&cm, q, v, m, kernel) != 0
+        || (out && interval > 0.0 && !grid && row_copies_room(&copies, &cm) != 0)) {
         contact_reject(msg, len, "memory", (double)q->memory, "out of memory for the springpot's modes");
         return finish(&cm, &copies, o, FC_ENOMEM);
     }
     watch_run(w, &cm);
-    uniform = contact_steps_uniformly(q);
-    grid = rows_on_grid(q);
     if (out)
         keep(out, &cm);
     while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * dt : 0.0))) {

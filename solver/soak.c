@@ -196,7 +196,7 @@ static int steps(double target)
            "\"rss_mib_samples\": [", cm.s.steps, cm.s.impacts, cm.s.t, wall_now() - t0);
     for (i = 0; i < k; i++)
         printf("%s%.2f", i ? ", " : "", rss[i]);
-    printf("], \"rss_mib_max\": %.2f, \"state_bytes\": %lu}\n", max_rss, (unsigned long)sizeof cm);
+    printf("], \"rss_mib_max\": %.2f, \"state_bytes\": %lu}\n", max_rss, (unsigned long)contact_model_bytes(&cm));
     return 0;
 }
 
