@@ -152,18 +152,22 @@ typedef struct {
     INT64(n) INT64(steps) INT64(impacts) DOUBLE(h_next) INT(in_contact)
 
 /* The compressed memory (a springpot with memory = 2): the kernel's modes,
- * their state, and the coefficients of one step length. */
+ * their state, and the coefficients of one step length, in arrays of
+ * `room` values each (the modes padded to whole lanes) that share one block
+ * the model owns: allocated when a run is configured, none for the other
+ * dampers and memories (contact_release frees it). */
 typedef struct {
     size_t modes;                 /* M, the last one the lumped spring (b = 0) */
+    size_t room;                  /* the arrays' length (0: no block): the arrays below are one block */
     double eta;                   /* the lumped dashpot */
-    double a[CONTACT_MAX_MODES], b[CONTACT_MAX_MODES];
-    double phi[CONTACT_MAX_MODES]; /* the modes' state: the Maxwell springs' stretch [m] */
+    double *a, *b;                /* a: the block's start */
+    double *phi;                  /* the modes' state: the Maxwell springs' stretch [m] */
     double h;                     /* the step length of the coefficients below (0: none yet) */
     double sum_p, sum_q;          /* sum_i p_i, sum_i q_i */
-    double p[CONTACT_MAX_MODES], q[CONTACT_MAX_MODES];      /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
-    double keep[CONTACT_MAX_MODES], rate1[CONTACT_MAX_MODES], rate2[CONTACT_MAX_MODES]; /* the update */
+    double *p, *q;                /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
+    double *keep, *rate1, *rate2; /* the update */
     double radau_h; /* the step length of radau_d (0: none yet) */
-    double radau_d[5][CONTACT_MAX_MODES]; /* Radau IIA's 1/(1 + h b lambda_l): lambda_0's, the pairs' re, -im */
+    double *radau_d; /* Radau IIA's 1/(1 + h b lambda_l), five arrays (RADAU_RECIPROCAL): lambda_0's, the pairs' re, -im */
 } contact_modes; /* a new field: copy it in contact_copy too */
 
 /* The full G1 history (a springpot with memory = 1): x2 at every step since
@@ -196,7 +200,7 @@ typedef struct {
     double contact_step;    /* the fixed step in the current contact: h_max, or shorter to resolve it */
     int64_t max_steps;      /* the most internal steps one advance may take; 0: no limit */
     int exceeded;           /* set by an advance that fails: whether it stopped at max_steps */
-    contact_modes modes;      /* a springpot's compressed memory */
+    contact_modes modes;      /* a springpot's compressed memory (owned: contact_release) */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
 
@@ -348,13 +352,16 @@ int contact_step_warning(const contact_params *p, double v, double m, char *msg,
  * stiffness, the compressed memory's kernel, the fixed step of a contact in
  * progress: from the state, inv_m and accel, which must be set), leaving
  * the state and the memory's values alone: for a state restored from
- * elsewhere. */
-void contact_configure(contact_model *cm, const contact_params *p);
+ * elsewhere. The compressed memory's block stays where it holds the
+ * kernel's modes; a larger one replaces it. 0, or -1 when memory for the
+ * modes runs out (the model as it was). */
+int contact_configure(contact_model *cm, const contact_params *p);
 
 /* Starts at t = 0 with the striker at the gap gap0 moving at v0 (towards the
  * specimen). Parameters and striker must have passed the checks above. The
- * model is overwritten: release one that holds a G1 history first. */
-void contact_start(contact_model *cm, const contact_params *p, double v0, double m);
+ * model is overwritten: release one that holds memory first. 0, or -1 when
+ * memory for the compressed memory's modes runs out (nothing to release). */
+int contact_start(contact_model *cm, const contact_params *p, double v0, double m);
 
 /* A compressed memory's kernel and what it was built for (soe.h), kept by a
  * caller that starts many models alike, as a batch of runs does: building
@@ -368,17 +375,29 @@ typedef struct {
 /* contact_start, taking the kernel from *kernel when it was built for the
  * same damper_order, memory_tolerance and kernel floor (the same bits as
  * building it), and keeping the one it builds there otherwise. */
-void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel);
+int contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel);
 
-/* Frees the G1 history's buffer (the only memory a model allocates, when a
- * springpot with memory = 1 steps); the model may start again. A struct copy
- * of such a model shares the buffer: never advance both. */
+/* Frees the memory a model allocates: the compressed memory's block and the
+ * full G1 history's buffer; the model may start again. A model copied by
+ * contact_copy shares the history's buffer: never advance both. */
 void contact_release(contact_model *cm);
 
-/* *to = *from, the compressed memory's arrays only as far as they hold
- * modes (a dashpot's model is a twentieth of the struct): for a caller that
- * copies a model at every step. The same sharing of a G1 history. */
+/* Frees the compressed memory's block alone: for a copy, whose G1 history
+ * is its original's. */
+void contact_release_modes(contact_model *cm);
+
+/* Makes *to (released, or zeroed) hold a copy of *from: its own block as
+ * large as from's modes, allocated here, not by contact_copy. 0, or -1 when
+ * memory for them runs out (to as it was). */
+int contact_copy_room(contact_model *to, const contact_model *from);
+
+/* *to = *from into to's own block (contact_copy_room first), the compressed
+ * memory's arrays only as far as they hold modes: for a caller that copies
+ * a model at every step. The G1 history's buffer is shared. */
 void contact_copy(contact_model *to, const contact_model *from);
+
+/* The bytes a model holds: the struct and what it allocated. */
+size_t contact_model_bytes(const contact_model *cm);
 
 /* The springpot's memory beside the state, as `count` values for saving and
  * restoring it: the damper's rate x2' first, then the compressed modes'

@@ -138,6 +138,10 @@ static inline double spring_force(const contact_model *cm, double K, double x1)
  * a divisor of CONTACT_MAX_MODES. */
 #define CONTACT_MODE_LANES 8
 
+/* The l-th of the compressed memory's five arrays of Radau IIA's
+ * reciprocals, one after another in its block (contact.h). */
+#define RADAU_RECIPROCAL(m, l) ((m)->radau_d + (l) * (m)->room)
+
 /* contact_spring_stiffness, inline for the steps that take it every time. */
 static inline double spring_stiffness(const contact_model *cm, long n_steps)
 {

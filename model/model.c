@@ -13,11 +13,11 @@
 #define GAMMA_5_2 1.329340388179137
 
 /* Zero modes up to a whole number of the lanes the springpot's passes sum
- * in: they add exact zeros. */
+ * in (the arrays' room): they add exact zeros. */
 static void pad_modes(contact_modes *m)
 {
     size_t j;
-    for (j = m->modes; j % CONTACT_MODE_LANES != 0 && j < CONTACT_MAX_MODES; j++)
+    for (j = m->modes; j < m->room; j++)
         m->a[j] = m->b[j] = m->phi[j] = 0.0;
 }
 
@@ -27,33 +27,70 @@ static int kernel_fits(const contact_kernel *k, const contact_params *p)
            && k->memory_tolerance == p->memory_tolerance;
 }
 
-/* The compressed memory's kernel (docs/model.md §6), from *kept when it
- * fits p, and kept there otherwise (kept may be NULL). */
-static void memory_kernel(contact_modes *m, const contact_params *p, contact_kernel *kept)
+/* The arrays of the compressed memory's block, one after another. */
+#define MODE_ARRAYS 13
+
+/* The block's arrays for `modes` modes, padded to whole lanes: the block
+ * kept where it holds them, a new one replacing it otherwise, its values
+ * unset (whoever takes it sets what a step reads: modes_at_rest,
+ * pad_modes, contact_copy). 0, or -1 when memory runs out (the block as it
+ * was). */
+static int reserve_modes(contact_modes *m, size_t modes)
 {
-    if (kept && kernel_fits(kept, p)) { /* only a kernel that fits is kept */
-        m->modes = kept->modes;
-        m->eta = kept->eta;
-        memcpy(m->a, kept->a, kept->modes * sizeof m->a[0]);
-        memcpy(m->b, kept->b, kept->modes * sizeof m->b[0]);
-        return;
-    }
-    m->modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p), CONTACT_MEMORY_SPAN,
-                          CONTACT_MAX_MODES, m->a, m->b, &m->eta);
-    if (kept && m->modes <= CONTACT_MAX_MODES) {
-        kept->damper_order = p->damper_order;
-        kept->memory_tolerance = p->memory_tolerance;
-        kept->floor = memory_kernel_floor(p);
-        kept->modes = m->modes;
-        kept->eta = m->eta;
-        memcpy(kept->a, m->a, m->modes * sizeof m->a[0]);
-        memcpy(kept->b, m->b, m->modes * sizeof m->b[0]);
-    }
+    const size_t room = (modes + CONTACT_MODE_LANES - 1) / CONTACT_MODE_LANES * CONTACT_MODE_LANES;
+    double *block;
+    if (room <= m->room)
+        return 0;
+    block = malloc(MODE_ARRAYS * room * sizeof *block);
+    if (!block)
+        return -1;
+    free(m->a);
+    m->room = room;
+    m->a = block;
+    m->b = block + room;
+    m->phi = block + 2 * room;
+    m->p = block + 3 * room;
+    m->q = block + 4 * room;
+    m->keep = block + 5 * room;
+    m->rate1 = block + 6 * room;
+    m->rate2 = block + 7 * room;
+    m->radau_d = block + 8 * room;
+    return 0;
 }
 
-static void configure(contact_model *cm, const contact_params *p, contact_kernel *kept)
+/* The compressed memory's kernel (docs/model.md §6), from *kept when it
+ * fits p, and kept there otherwise (kept may be NULL); -1 when memory for
+ * its modes runs out. */
+static int memory_kernel(contact_modes *m, const contact_params *p, contact_kernel *kept)
+{
+    contact_kernel built;
+    const contact_kernel *k = kept && kernel_fits(kept, p) ? kept : &built; /* only a kernel that fits is kept */
+    if (k == &built) {
+        built.modes = soe_kernel(p->damper_order, p->memory_tolerance, memory_kernel_floor(p), CONTACT_MEMORY_SPAN,
+                                 CONTACT_MAX_MODES, built.a, built.b, &built.eta);
+        if (built.modes > CONTACT_MAX_MODES) /* contact_check_params refuses such parameters */
+            built.modes = CONTACT_MAX_MODES;
+        built.damper_order = p->damper_order;
+        built.memory_tolerance = p->memory_tolerance;
+        built.floor = memory_kernel_floor(p);
+        if (kept)
+            *kept = built;
+    }
+    if (reserve_modes(m, k->modes) != 0)
+        return -1;
+    m->modes = k->modes;
+    m->eta = k->eta;
+    memcpy(m->a, k->a, k->modes * sizeof m->a[0]);
+    memcpy(m->b, k->b, k->modes * sizeof m->b[0]);
+    return 0;
+}
+
+static int configure(contact_model *cm, const contact_params *p, contact_kernel *kept)
 {
     const double n = p->spring_exponent;
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_COMPRESSED
+        && memory_kernel(&cm->modes, p, kept) != 0)
+        return -1;
     cm->p = *p;
     cm->k = spring_constant(p);
     cm->n_gamma = n == 1.5 ? GAMMA_5_2 : tgamma(n + 1.0);
@@ -68,43 +105,12 @@ static void configure(contact_model *cm, const contact_params *p, contact_kernel
     cm->series_limit = error_controlled(cm) ? pow(1e-3 * p->tolerance / 20.0, 2.0 / 7.0) : 0.0;
     cm->peak_force_seen = -1.0;
     cm->peak_length = 0.0;
-    cm->modes.modes = 0;
+    if (!compressed_memory(cm))
+        cm->modes.modes = 0;
     cm->modes.h = 0.0;
     cm->modes.radau_h = 0.0;
-    if (compressed_memory(cm))
-        memory_kernel(&cm->modes, p, kept);
     pad_modes(&cm->modes);
-}
-
-void contact_configure(contact_model *cm, const contact_params *p)
-{
-    configure(cm, p, NULL);
-}
-
-void contact_release(contact_model *cm)
-{
-    free(cm->history.x2);
-    free(cm->history.w);
-    memset(&cm->history, 0, sizeof cm->history);
-}
-
-void contact_start(contact_model *cm, const contact_params *p, double v0, double m)
-{
-    contact_start_with(cm, p, v0, m, NULL);
-}
-
-/* Clears a model but for the springpot's arrays, whose part a run uses
- * configure and contact_start_with fill: its modes, padded to whole lanes
- * (as contact_copy copies them). All of them are most of a short run's
- * work to clear, and most of them a run with few modes, or none, never
- * touches. */
-static void clear_model(contact_model *cm)
-{
-    contact_modes *m = &cm->modes;
-    memset(cm, 0, offsetof(contact_model, modes));
-    m->modes = 0;
-    m->eta = m->h = m->sum_p = m->sum_q = m->radau_h = 0.0;
-    memset(&cm->history, 0, sizeof cm->history);
+    return 0;
 }
 
 /* The memory at rest (pad_modes zeroed the padding), and the coefficients
@@ -113,7 +119,9 @@ static void clear_model(contact_model *cm)
  * as they are. */
 static void modes_at_rest(contact_modes *m)
 {
-    const size_t bytes = (m->modes < CONTACT_MAX_MODES ? m->modes : CONTACT_MAX_MODES) * sizeof m->phi[0];
+    const size_t bytes = m->modes * sizeof m->phi[0];
+    if (!m->modes)
+        return;
     memset(m->phi, 0, bytes);
     memset(m->p, 0, bytes);
     memset(m->q, 0, bytes);
@@ -122,10 +130,51 @@ static void modes_at_rest(contact_modes *m)
     memset(m->rate2, 0, bytes);
 }
 
-void contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
+int contact_configure(contact_model *cm, const contact_params *p)
+{
+    const double *block = cm->modes.a;
+    if (configure(cm, p, NULL) != 0)
+        return -1;
+    if (cm->modes.a != block) /* a new block: the coefficients too at rest */
+        modes_at_rest(&cm->modes);
+    return 0;
+}
+
+void contact_release_modes(contact_model *cm)
+{
+    free(cm->modes.a);
+    memset(&cm->modes, 0, sizeof cm->modes);
+}
+
+void contact_release(contact_model *cm)
+{
+    contact_release_modes(cm);
+    free(cm->history.x2);
+    free(cm->history.w);
+    memset(&cm->history, 0, sizeof cm->history);
+}
+
+int contact_start(contact_model *cm, const contact_params *p, double v0, double m)
+{
+    return contact_start_with(cm, p, v0, m, NULL);
+}
+
+/* Clears a model, its memory none (configure allocates the compressed
+ * memory's block): the fields before the modes as one, the modes' and the
+ * history's one by one. */
+static void clear_model(contact_model *cm)
+{
+    static const contact_modes no_modes;
+    memset(cm, 0, offsetof(contact_model, modes));
+    cm->modes = no_modes;
+    memset(&cm->history, 0, sizeof cm->history);
+}
+
+int contact_start_with(contact_model *cm, const contact_params *p, double v0, double m, contact_kernel *kernel)
 {
     clear_model(cm);
-    configure(cm, p, kernel);
+    if (configure(cm, p, kernel) != 0)
+        return -1;
     modes_at_rest(&cm->modes);
     cm->s.x1 = -p->gap0;
     cm->s.v = v0;
@@ -136,6 +185,7 @@ void contact_start_with(contact_model *cm, const contact_params *p, double v0, d
     } else {
         contact_drive(cm, v0, m, 0.0);
     }
+    return 0;
 }
 
 void contact_drive(contact_model *cm, double v, double m, double accel)
@@ -285,13 +335,18 @@ void contact_memory_set(contact_model *cm, size_t i, double value)
         cm->history.x2[i - 3] = value;
 }
 
+int contact_copy_room(contact_model *to, const contact_model *from)
+{
+    return from->modes.modes ? reserve_modes(&to->modes, from->modes.modes) : 0;
+}
+
 void contact_copy(contact_model *to, const contact_model *from)
 {
     const contact_modes *f = &from->modes;
     contact_modes *t = &to->modes;
     const size_t bytes = f->modes * sizeof f->a[0];
     /* all but the modes, then the modes' scalars and the used part of each
-     * array, padded as the original's */
+     * array into to's block, padded as the original's */
     memcpy(to, from, offsetof(contact_model, modes));
     to->history = from->history;
     t->modes = f->modes;
@@ -300,6 +355,8 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->radau_h = 0.0; /* radau_d is not copied */
     t->sum_p = f->sum_p;
     t->sum_q = f->sum_q;
+    if (!f->modes)
+        return;
     memcpy(t->a, f->a, bytes);
     memcpy(t->b, f->b, bytes);
     memcpy(t->phi, f->phi, bytes);
@@ -309,4 +366,10 @@ void contact_copy(contact_model *to, const contact_model *from)
     memcpy(t->rate1, f->rate1, bytes);
     memcpy(t->rate2, f->rate2, bytes);
     pad_modes(t);
+}
+
+size_t contact_model_bytes(const contact_model *cm)
+{
+    return sizeof *cm + MODE_ARRAYS * cm->modes.room * sizeof(double)
+           + 2 * cm->history.capacity * sizeof(double);
 }

@@ -186,6 +186,11 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
 {
     const double l0 = radau_lambda[0][0], r1 = radau_lambda[1][0], i1 = radau_lambda[1][1];
     const double r2 = radau_lambda[2][0], i2 = radau_lambda[2][1];
+    /* the arrays apart, as the compiler cannot tell them from their pointers */
+    const double *restrict const mode_a = m->a, *restrict const mode_b = m->b, *restrict const mode_phi = m->phi;
+    double *restrict const d0_of = RADAU_RECIPROCAL(m, 0), *restrict const c1r_of = RADAU_RECIPROCAL(m, 1);
+    double *restrict const c1i_of = RADAU_RECIPROCAL(m, 2), *restrict const c2r_of = RADAU_RECIPROCAL(m, 3);
+    double *restrict const c2i_of = RADAU_RECIPROCAL(m, 4);
     double lane[SUMS][CONTACT_MODE_LANES];
     size_t j;
     int k, n;
@@ -195,18 +200,18 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
     for (j = first; j < m->modes; j += CONTACT_MODE_LANES) { /* the reciprocals and the sums of a d */
 #pragma omp simd
         for (k = 0; k < width; k++) {
-            const double x = h * m->b[j + k], a = m->a[j + k];
+            const double x = h * mode_b[j + k], a = mode_a[j + k];
             const double D0 = 1.0 + x * l0;
             const double u1 = 1.0 + x * r1, v1 = x * i1, N1 = u1 * u1 + v1 * v1;
             const double u2 = 1.0 + x * r2, v2 = x * i2, N2 = u2 * u2 + v2 * v2;
             const double inv = 1.0 / (D0 * (N1 * N2));
             const double d0 = (N1 * N2) * inv, k1 = (D0 * N2) * inv, k2 = (D0 * N1) * inv;
             const double ad = a * d0, c1r = k1 * u1, c1i = k1 * v1, c2r = k2 * u2, c2i = k2 * v2;
-            m->radau_d[0][j + k] = d0;
-            m->radau_d[1][j + k] = c1r;
-            m->radau_d[2][j + k] = c1i;
-            m->radau_d[3][j + k] = c2r;
-            m->radau_d[4][j + k] = c2i;
+            d0_of[j + k] = d0;
+            c1r_of[j + k] = c1r;
+            c1i_of[j + k] = c1i;
+            c2r_of[j + k] = c2r;
+            c2i_of[j + k] = c2i;
             lane[SUM_Q0][k] += ad;
             lane[SUM_QQ0][k] += ad * d0;
             lane[SUM_Q1R][k] += a * c1r;
@@ -218,16 +223,16 @@ static inline ALWAYS_INLINE void memory_sums_in_vector(const int width, int firs
     for (j = first; j < m->modes; j += CONTACT_MODE_LANES) { /* the sums of a phi d, from the reciprocals */
 #pragma omp simd
         for (k = 0; k < width; k++) {
-            const double x = h * m->b[j + k], ap = m->a[j + k] * m->phi[j + k];
-            const double d0 = m->radau_d[0][j + k];
+            const double x = h * mode_b[j + k], ap = mode_a[j + k] * mode_phi[j + k];
+            const double d0 = d0_of[j + k];
             const double apd = ap * d0;
             lane[SUM_RELAXED][k] += apd * (x * l0);
             lane[SUM_P0][k] += apd;
             lane[SUM_PP0][k] += apd * d0;
-            lane[SUM_P1R][k] += ap * m->radau_d[1][j + k];
-            lane[SUM_P1I][k] -= ap * m->radau_d[2][j + k];
-            lane[SUM_P2R][k] += ap * m->radau_d[3][j + k];
-            lane[SUM_P2I][k] -= ap * m->radau_d[4][j + k];
+            lane[SUM_P1R][k] += ap * c1r_of[j + k];
+            lane[SUM_P1I][k] -= ap * c1i_of[j + k];
+            lane[SUM_P2R][k] += ap * c2r_of[j + k];
+            lane[SUM_P2I][k] -= ap * c2i_of[j + k];
         }
     }
     for (n = 0; n < SUMS; n++)
@@ -493,15 +498,19 @@ static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, const com
 {
     const double t0 = tau[0].re, t1r = tau[1].re, t1i = tau[1].im, t2r = tau[2].re, t2i = tau[2].im;
     const double w0 = tau_W[0].re, w1r = tau_W[1].re, w1i = tau_W[1].im, w2r = tau_W[2].re, w2i = tau_W[2].im;
+    const double *restrict const d0_of = RADAU_RECIPROCAL(m, 0), *restrict const c1r_of = RADAU_RECIPROCAL(m, 1);
+    const double *restrict const c1i_of = RADAU_RECIPROCAL(m, 2), *restrict const c2r_of = RADAU_RECIPROCAL(m, 3);
+    const double *restrict const c2i_of = RADAU_RECIPROCAL(m, 4);
+    double *restrict const phi_of = m->phi;
     size_t j;
 #pragma omp simd
     for (j = 0; j < m->modes; j++) {
         /* Re(tau (phi + W) d) coordinate by coordinate */
-        const double phi = m->phi[j];
+        const double phi = phi_of[j];
         const double n0 = phi * t0 + w0;
-        const double n1 = (phi * t1r + w1r) * m->radau_d[1][j] + (phi * t1i + w1i) * m->radau_d[2][j];
-        const double n2 = (phi * t2r + w2r) * m->radau_d[3][j] + (phi * t2i + w2i) * m->radau_d[4][j];
-        m->phi[j] = n0 * m->radau_d[0][j] + (n1 + n2);
+        const double n1 = (phi * t1r + w1r) * c1r_of[j] + (phi * t1i + w1i) * c1i_of[j];
+        const double n2 = (phi * t2r + w2r) * c2r_of[j] + (phi * t2i + w2i) * c2i_of[j];
+        phi_of[j] = n0 * d0_of[j] + (n1 + n2);
     }
 }
 

@@ -973,11 +973,11 @@ def springpot_section(r):
                  "impact.")
     if r["sizes"]["this"]:
         paragraph += (" Each model (an FMU instance, a library run) is a `contact_model` of "
-                      f"{r['sizes']['this']['model']:,} B whatever the damper")
+                      f"{r['sizes']['this']['model']:,} B")
         if r["sizes"]["base"]:
-            paragraph += (f" ({r['sizes']['base']['model']:,} B before the springpot: the compressed memory's "
-                          "160 modes' arrays are inside it)")
-        paragraph += "."
+            paragraph += f" ({r['sizes']['base']['model']:,} B before the springpot)"
+        paragraph += (": the compressed memory's modes take a block of their own, sized by the kernel's mode "
+                      "count (docs/reliability.md).")
     out += ["", paragraph, ""]
     out += ["### The N ladder: compressed memory against the full history", "",
             f"A springpot impact over a fixed span of {sp['span'] * 1e3:g} ms (the impact lasts 1.42 ms, then the "

@@ -156,8 +156,10 @@ MUTANTS = [
     mutant("radau-advance-pair", "time scheme", "Radau IIA: the modes' update divides the second complex pair's "
            "term by the wrong pair",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage",
-           (RADAU, "(phi * t2r + w2r) * m->radau_d[3][j] + (phi * t2i + w2i) * m->radau_d[4][j];",
-            "(phi * t2r + w2r) * m->radau_d[1][j] + (phi * t2i + w2i) * m->radau_d[2][j];")),
+           (RADAU, "(phi * t1r + w1r) * c1r_of[j] + (phi * t1i + w1i) * c1i_of[j];\n"
+                   "        const double n2 = (phi * t2r + w2r) * c2r_of[j] + (phi * t2i + w2i) * c2i_of[j];",
+            "(phi * t1r + w1r) * c2r_of[j] + (phi * t1i + w1i) * c2i_of[j];\n"
+            "        const double n2 = (phi * t2r + w2r) * c1r_of[j] + (phi * t2i + w2i) * c1i_of[j];")),
     mutant("radau-kept-reciprocals", "time scheme", "Radau IIA: the modes' update takes the kept reciprocals "
            "whatever trial's step they were built for",
            STRUCTURAL + "; test_contact test_radau_modes_are_the_last_stage: the update of a model copied "

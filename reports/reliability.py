@@ -39,7 +39,7 @@ def sh(*args, **kw):
 
 def soak(build):
     run = lambda *a: json.loads(sh(build / "fraccontact-soak", *a).stdout)
-    return dict(instances=run("instances", 10000), threads=run("threads", 8), steps=run("steps", 1e8),
+    return dict(instances=run("instances", 10000), memory=run("memory"), threads=run("threads", 8), steps=run("steps", 1e8),
                 resting=run("fmu-seconds", 60))
 
 
@@ -120,6 +120,27 @@ FUZZ_BUDGET = ("Each input's work is bounded (`tests/fuzz_program.h`): at most 1
                "17,500 inputs a harness.")
 
 
+def configuration_name(c):
+    """A configuration of fraccontact-soak memory, as the page names it."""
+    if c["damper"] == 1:
+        return "dashpot"
+    if c["memory"] == 1:
+        return "springpot, memory = 1 (before its first step)"
+    return f"springpot, memory = 2, memory_tolerance = {c['memory_tolerance']:g} (M = {c['modes']})"
+
+
+def memory_sentence(m):
+    """The memory an instance holds per configuration (fraccontact-soak memory)."""
+    sizes = "; ".join(f"{configuration_name(c)}: {c['instance_bytes']:,} B, state {c['state_bytes']:,} B"
+                      for c in m["configurations"])
+    return ("- **Memory per configuration** (`fraccontact-soak memory`: the heap bytes an initialized FMU instance "
+            "holds, malloc's own overhead included, and its serialized FMU state's size): " + sizes + ". A dashpot "
+            "instance holds no springpot memory: at most 2 KiB. The compressed memory's M modes take, in the model "
+            "and again in its prediction of the next step, one block of 13 arrays of M doubles rounded up to whole "
+            "8 lanes, allocated at initialization (never in a step); the FMU state 8 B a mode. The full G1 "
+            "history's buffer grows as the run steps (16 B a step; 8 B a step in the state).")
+
+
 def write(path, s, v, f, hostile_summary):
     steps = s["steps"]
     lines = ["# Reliability", "",
@@ -130,10 +151,11 @@ def write(path, s, v, f, hostile_summary):
              f"{s['instances']['rss_before_mib']:.1f} MiB before, {s['instances']['rss_alive_mib']:.1f} MiB with all "
              f"alive ({s['instances']['kib_per_instance']:.1f} KiB per instance: an instance holds the contact model "
              f"twice, its state and its prediction of the next communication step, "
-             f"{s['instances']['bytes_contact_model']:,} B each, most of it the compressed memory's arrays for "
-             f"{s['instances']['max_modes']} modes, whatever the damper); each then run through an impact "
+             f"{s['instances']['bytes_contact_model']:,} B each with the dashpot, which holds no springpot memory); "
+             f"each then run through an impact "
              f"(dt_max = 1e-6 s), {s['instances']['seconds_for_all_impacts']:.2f} s for all; every 997th compared "
              f"with the same instance alone: {'identical' if not s['instances']['sampled_differ_from_alone'] else 'DIFFERENT'}.",
+             memory_sentence(s["memory"]),
              f"- **{s['threads']['threads']} threads** stepping {s['threads']['instances']} distinct instances at "
              f"once (FMI allows that; nothing in the FMU is shared): results "
              f"{'identical, bit for bit,' if s['threads']['identical_to_one_thread'] else 'DIFFERENT'} to one thread "

@@ -86,14 +86,19 @@ size_t fc_memory_kernel(const fc_params *p, size_t max, double *a, double *b, do
     q.damper = CONTACT_DAMPER_SPRINGPOT;
     q.memory = CONTACT_MEMORY_COMPRESSED;
     memset(&cm, 0, sizeof cm);
-    contact_configure(&cm, &q);
+    if (contact_configure(&cm, &q) != 0) {
+        contact_reject(msg, len, "memory", (double)q.memory, "out of memory for the springpot's modes");
+        return 0;
+    }
     if (cm.modes.modes <= max)
         for (i = 0; i < cm.modes.modes; i++) {
             a[i] = cm.modes.a[i];
             b[i] = cm.modes.b[i];
         }
     *eta = cm.modes.eta;
-    return cm.modes.modes;
+    i = cm.modes.modes;
+    contact_release(&cm);
+    return i;
 }
 
 double fc_step_limit(const fc_params *p)
@@ -334,37 +339,53 @@ static void keep(series *s, const contact_model *cm)
     series_add(s, row);
 }
 
+/* The copies of the model a run's rows are computed from (keep_rows_until),
+ * each with its own compressed memory's block, allocated when the run
+ * starts. */
+typedef struct {
+    contact_model snapshot, cursor, at;
+} row_copies;
+
+/* Room in the copies for the modes of *cm: 0, or -1 when memory runs out. */
+static int row_copies_room(row_copies *c, const contact_model *cm)
+{
+    if (contact_copy_room(&c->snapshot, cm) != 0 || contact_copy_room(&c->cursor, cm) != 0)
+        return -1;
+    return contact_copy_room(&c->at, cm);
+}
+
 /* Rows at the output times k * interval in (from->s.t, t], each the model
  * advanced to that time from a copy of the state, so that what the rows
  * show never changes the steps the run takes. The copy is the last state
  * of the run's own steps before the row: out of contact a recovering
  * springpot's flight is one advance of many steps, which the rows retrace
  * once, step by step, not once a row. Their work counts towards w's. */
-static void keep_rows_until(series *out, const contact_model *from, double t, double interval, int64_t *k, watch *w)
+static void keep_rows_until(series *out, const contact_model *from, double t, double interval, int64_t *k, watch *w,
+                            row_copies *c)
 {
-    contact_model cursor, at;
+    contact_model *const cursor = &c->cursor, *const at = &c->at;
     int64_t steps = 0;
-    contact_copy(&cursor, from);
-    cursor.poll = NULL; /* the run's: not the rows' steps */
+    contact_copy(cursor, from);
+    cursor->poll = NULL; /* the run's: not the rows' steps */
     for (; interval > 0.0 && (double)*k * interval <= t && !out->failed; ++*k) {
         const double t_row = (double)*k * interval;
         for (;;) {
-            contact_copy(&at, &cursor);
-            if (!(t_row > at.s.t))
+            contact_copy(at, cursor);
+            if (!(t_row > at->s.t))
                 break;
-            if (isnan(contact_advance_until(&at, t_row - at.s.t, CONTACT_FLIGHT_STEP)))
+            if (isnan(contact_advance_until(at, t_row - at->s.t, CONTACT_FLIGHT_STEP)))
                 return;
-            steps += 1 + at.s.steps - cursor.s.steps;
+            steps += 1 + at->s.steps - cursor->s.steps;
             if (steps >= PROGRESS_WORK) {
                 if (stop_asked(w, steps))
                     return;
                 steps = 0;
             }
-            if (!(at.s.t < t_row))
+            if (!(at->s.t < t_row))
                 break;
-            contact_copy(&cursor, &at); /* a whole step of the run's short of the row */
+            contact_copy(cursor, at); /* a whole step of the run's short of the row */
         }
-        keep(out, &at);
+        keep(out, at);
     }
     stop_asked(w, steps);
 }
@@ -446,10 +467,13 @@ static fc_status rows_failed(const series *out, double interval, double t, char 
 }
 
 /* Ends a run where cm is (with a message already written if it failed). */
-static fc_status finish(contact_model *cm, fc_outcome *o, fc_status status)
+static fc_status finish(contact_model *cm, row_copies *c, fc_outcome *o, fc_status status)
 {
     summarize(cm, o);
     contact_release(cm);
+    contact_release_modes(&c->snapshot);
+    contact_release_modes(&c->cursor);
+    contact_release_modes(&c->at);
     return o->status = status;
 }
 
@@ -459,7 +483,9 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
                      contact_kernel *kernel, fc_outcome *o, char *msg, size_t len)
 {
     const contact_params *q = &p->model;
-    contact_model cm, snapshot;
+    static const contact_modes no_modes;
+    contact_model cm;
+    row_copies copies;
     double E_diss_onset = 0.0;
     int64_t k = 1;
     int uniform, grid;
@@ -469,10 +495,15 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         return o->status = FC_EINVAL;
     fc_striker(p, &v, &m);
     dt = contact_step_limit(q);
-    contact_start_with(&cm, q, v, m, kernel);
-    watch_run(w, &cm);
+    copies.snapshot.modes = copies.cursor.modes = copies.at.modes = no_modes;
     uniform = contact_steps_uniformly(q);
     grid = rows_on_grid(q);
+    if (contact_start_with(&cm, q, v, m, kernel) != 0
+        || (out && interval > 0.0 && !grid && row_copies_room(&copies, &cm) != 0)) {
+        contact_reject(msg, len, "memory", (double)q->memory, "out of memory for the springpot's modes");
+        return finish(&cm, &copies, o, FC_ENOMEM);
+    }
+    watch_run(w, &cm);
     if (out)
         keep(out, &cm);
     while (!(o->stop = why_stop(p, &cm, uniform ? 1e-6 * dt : 0.0))) {
@@ -482,15 +513,15 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         if (grid) {
             H = dt;
             if (contact_check_advance(&cm, H, msg, len) != 0)
-                return finish(&cm, o, FC_EFAIL);
+                return finish(&cm, &copies, o, FC_EFAIL);
         } else if (cm.s.in_contact || uniform)
             H = fmin(H, dt);
         rows_inside = out && interval > 0.0 && !grid && (double)k * interval <= cm.s.t + H;
         if (rows_inside)
-            contact_copy(&snapshot, &cm); /* no G1 history in it */
+            contact_copy(&copies.snapshot, &cm); /* no G1 history in it */
         if (isnan(contact_advance_until(&cm, H, CONTACT_ONSET | CONTACT_SEPARATION))) {
             contact_reject(msg, len, "t", cm.s.t, "the state became non-finite in the step from here [s]");
-            return finish(&cm, o, FC_EFAIL);
+            return finish(&cm, &copies, o, FC_EFAIL);
         }
         if (cm.s.in_contact && !before.in_contact)
             E_diss_onset = before.E_diss;
@@ -500,14 +531,14 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
                 o->first = done;
             if (impacts && impact_list_add(impacts, &done) != 0) {
                 contact_reject(msg, len, "impacts", (double)cm.s.impacts, "out of memory for the per-impact figures");
-                return finish(&cm, o, FC_ENOMEM);
+                return finish(&cm, &copies, o, FC_ENOMEM);
             }
         }
         if (out) {
             if (grid)
                 keep_grid_rows_until(out, &cm, interval, &k);
             else if (rows_inside)
-                keep_rows_until(out, &snapshot, cm.s.t, interval, &k, w);
+                keep_rows_until(out, &copies.snapshot, cm.s.t, interval, &k, w, &copies);
             if (interval == 0.0 || cm.s.in_contact != before.in_contact)
                 keep(out, &cm);
             if (out->failed)
@@ -515,15 +546,15 @@ static fc_status run(const fc_params *p, double interval, series *out, impact_li
         }
         if (stop_due(w) && stop_asked(w, 0)) {
             snprintf(msg, len, "stopped at t = %.17g s: the progress callback asked to stop", cm.s.t);
-            return finish(&cm, o, FC_ESTOPPED);
+            return finish(&cm, &copies, o, FC_ESTOPPED);
         }
     }
     if (out) {
         keep(out, &cm);
         if (out->failed)
-            return finish(&cm, o, rows_failed(out, interval, cm.s.t, msg, len));
+            return finish(&cm, &copies, o, rows_failed(out, interval, cm.s.t, msg, len));
     }
-    return finish(&cm, o, FC_OK);
+    return finish(&cm, &copies, o, FC_OK);
 }
 
 fc_status fc_run_with_progress(const fc_params *p, double output_interval, fc_progress progress, void *ctx,

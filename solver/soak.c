@@ -8,10 +8,13 @@
  *   fraccontact-soak steps S          S internal steps of bouncing under gravity
  *                                     (the model), resident memory sampled
  *   fraccontact-soak fmu-seconds S    S simulated seconds of bouncing, then resting on
- *                                     the specimen, through the FMU (dt_max = 1e-6 s) */
+ *                                     the specimen, through the FMU (dt_max = 1e-6 s)
+ *   fraccontact-soak memory           the heap bytes an initialized instance holds and
+ *                                     its serialized FMU state's, per configuration */
 #define _POSIX_C_SOURCE 200809L
 
 #include <inttypes.h>
+#include <malloc.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -24,7 +27,8 @@
 #include "fmi2Functions.h"
 #include "guid.h"
 
-enum { VR_dt_max = 10, VR_c = 9, VR_g = 11, VR_F_peak = 15, VR_E_diss = 20, VR_eps = 21, VR_x2 = 18 };
+enum { VR_dt_max = 10, VR_c = 9, VR_g = 11, VR_F_peak = 15, VR_E_diss = 20, VR_eps = 21, VR_x2 = 18,
+       VR_memory_tolerance = 26, VR_damper = 33, VR_memory = 34 };
 
 static void quiet(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...)
 {
@@ -107,7 +111,7 @@ static int instances(long n)
            "\"seconds_for_all_impacts\": %.2f, \"sampled_differ_from_alone\": %s, \"bytes_contact_model\": %zu, "
            "\"max_modes\": %d}\n",
            n, before, alive, (alive - before) * 1024.0 / (double)n, wall_now() - t0, worst > 0 ? "true" : "false",
-           sizeof(contact_model), CONTACT_MAX_MODES);
+           contact_model_bytes(&(contact_model){0}), CONTACT_MAX_MODES);
     for (i = 0; i < n; i++)
         fmi2FreeInstance(x[i]);
     free(x);
@@ -192,7 +196,7 @@ static int steps(double target)
            "\"rss_mib_samples\": [", cm.s.steps, cm.s.impacts, cm.s.t, wall_now() - t0);
     for (i = 0; i < k; i++)
         printf("%s%.2f", i ? ", " : "", rss[i]);
-    printf("], \"rss_mib_max\": %.2f, \"state_bytes\": %lu}\n", max_rss, (unsigned long)sizeof cm);
+    printf("], \"rss_mib_max\": %.2f, \"state_bytes\": %lu}\n", max_rss, (unsigned long)contact_model_bytes(&cm));
     return 0;
 }
 
@@ -225,8 +229,72 @@ static int fmu_seconds(double seconds)
     return 0;
 }
 
+/* The heap's bytes in use (malloc's own overhead of each block included). */
+static size_t heap_bytes(void)
+{
+    return mallinfo2().uordblks;
+}
+
+/* One configuration's instance, initialized: the heap bytes it holds and
+ * its serialized FMU state's size, printed with the compressed memory's
+ * mode count (the model's kernel for the same parameters). */
+static int configuration_memory(int damper, int memory, double memory_tolerance, const char *comma)
+{
+    fmi2ValueReference vr_int[] = {VR_damper, VR_memory}, vr_real[] = {VR_memory_tolerance};
+    fmi2Integer ints[] = {damper, memory};
+    fmi2Real reals[] = {memory_tolerance};
+    contact_params p;
+    contact_model cm;
+    fmi2FMUstate state = NULL;
+    size_t before = heap_bytes(), held, state_bytes = 0, modes;
+    double v0, m;
+    fmi2Component x = fmi2Instantiate("soak", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
+    if (!x || fmi2SetInteger(x, vr_int, 2, ints) != fmi2OK || fmi2SetReal(x, vr_real, 1, reals) != fmi2OK
+        || fmi2EnterInitializationMode(x) != fmi2OK || fmi2ExitInitializationMode(x) != fmi2OK) {
+        fprintf(stderr, "fraccontact-soak: an instance (damper = %d, memory = %d) did not start\n", damper, memory);
+        return 1;
+    }
+    held = heap_bytes() - before;
+    if (fmi2GetFMUstate(x, &state) != fmi2OK || fmi2SerializedFMUstateSize(x, state, &state_bytes) != fmi2OK) {
+        fprintf(stderr, "fraccontact-soak: no FMU state (damper = %d, memory = %d)\n", damper, memory);
+        return 1;
+    }
+    fmi2FreeFMUstate(x, &state);
+    fmi2FreeInstance(x);
+    contact_default_params(&p);
+    p.damper = damper;
+    p.memory = memory;
+    p.memory_tolerance = memory_tolerance;
+    contact_default_striker(&v0, &m);
+    if (contact_start(&cm, &p, v0, m) != 0)
+        return 1;
+    modes = cm.modes.modes;
+    contact_release(&cm);
+    printf("{\"damper\": %d, \"memory\": %d, \"memory_tolerance\": %g, \"modes\": %zu, \"instance_bytes\": %zu, "
+           "\"state_bytes\": %zu}%s", damper, memory, memory_tolerance, modes, held, state_bytes, comma);
+    return 0;
+}
+
+/* The dashpot, the springpot's full G1 history before its first step, and
+ * its compressed memory at the default memory_tolerance and two others. */
+static int memory_per_configuration(void)
+{
+    int failed;
+    fmi2FreeInstance(drop(6080.0, 1e-6)); /* the first instance's one-time allocations apart */
+    printf("{\"bytes_contact_model\": %zu, \"configurations\": [", sizeof(contact_model));
+    failed = configuration_memory(CONTACT_DAMPER_DASHPOT, CONTACT_MEMORY_COMPRESSED, 1e-6, ", ")
+             || configuration_memory(CONTACT_DAMPER_SPRINGPOT, CONTACT_MEMORY_G1, 1e-6, ", ")
+             || configuration_memory(CONTACT_DAMPER_SPRINGPOT, CONTACT_MEMORY_COMPRESSED, 1e-3, ", ")
+             || configuration_memory(CONTACT_DAMPER_SPRINGPOT, CONTACT_MEMORY_COMPRESSED, 1e-6, ", ")
+             || configuration_memory(CONTACT_DAMPER_SPRINGPOT, CONTACT_MEMORY_COMPRESSED, 1e-10, "");
+    printf("]}\n");
+    return failed;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 2 && strcmp(argv[1], "memory") == 0)
+        return memory_per_configuration();
     if (argc == 3 && strcmp(argv[1], "instances") == 0)
         return instances(atol(argv[2]));
     if (argc == 3 && strcmp(argv[1], "threads") == 0)
@@ -235,6 +303,6 @@ int main(int argc, char **argv)
         return steps(atof(argv[2]));
     if (argc == 3 && strcmp(argv[1], "fmu-seconds") == 0)
         return fmu_seconds(atof(argv[2]));
-    fprintf(stderr, "usage: fraccontact-soak instances N | threads T | steps S | fmu-seconds S\n");
+    fprintf(stderr, "usage: fraccontact-soak instances N | threads T | steps S | fmu-seconds S | memory\n");
     return 2;
 }

@@ -321,6 +321,7 @@ static void test_springpot_onset_step(void)
             radau_step(&cm, &cm.s, h, spring_stiffness(&cm, cm.s.n + 1), &trial);
             CHECK(cm.s.in_contact && trial.error <= 1.0, "alpha %g, tolerance %g: the onset step %.3g errs %.3g",
                   alphas[i], tolerances[j], h, trial.error);
+            contact_release(&cm);
         }
 }
 
@@ -453,6 +454,8 @@ static void test_radau_modes_are_the_last_stage(void)
     radau_tableau(c, A);
     start_springpot_in_contact(&cm, 1e-8);
     CHECK(cm.s.in_contact && cm.modes.modes > 0, "in contact at 3e-4 s with %zu modes", cm.modes.modes);
+    memset(&after, 0, sizeof after);
+    CHECK(contact_copy_room(&after, &cm) == 0, "room for a copy of %zu modes", cm.modes.modes);
     for (i = 0; i < sizeof steps / sizeof steps[0]; i++) {
         const double h = steps[i];
         contact_state trial;
@@ -487,6 +490,8 @@ static void test_radau_modes_are_the_last_stage(void)
               "h = %g: the memory's force %.17g is the spring's %.17g", h,
               cm.p.c_alpha * (cm.modes.eta * trial.x2_rate + memory), trial.F);
     }
+    contact_release_modes(&after);
+    contact_release(&cm);
 }
 
 /* Radau IIA's dense output is the polynomial through x1 at the step's
@@ -520,7 +525,8 @@ static void test_radau_dense_output_interpolates(void)
 }
 
 /* A copied model steps as its original, to the bit, whatever the memory
- * it was copied into held before: here every byte 0xff (NaN), which the
+ * it was copied into held before: here every byte of the struct but its
+ * block's pointers, and of the block, 0xff (NaN), which the
  * springpot's passes would sum in the modes padded to whole lanes were
  * they not zeroed in the copy too. */
 static void test_a_copy_steps_as_its_original(void)
@@ -529,7 +535,10 @@ static void test_a_copy_steps_as_its_original(void)
     contact_state original, copied;
     double h, K;
     start_springpot_in_contact(&cm, 1e-6);
-    memset(&copy, 0xff, sizeof copy);
+    memset(&copy, 0, sizeof copy);
+    CHECK(contact_copy_room(&copy, &cm) == 0, "room for a copy of %zu modes", cm.modes.modes);
+    memset(&copy, 0xff, offsetof(contact_model, modes));
+    memset(copy.modes.a, 0xff, contact_model_bytes(&copy) - sizeof copy);
     contact_copy(&copy, &cm);
     h = cm.s.h_next, K = spring_stiffness(&cm, cm.s.n + 1);
     memset(&original, 0, sizeof original);
@@ -538,11 +547,13 @@ static void test_a_copy_steps_as_its_original(void)
     radau_step(&copy, &copy.s, h, K, &copied);
     CHECK(cm.modes.modes % CONTACT_MODE_LANES != 0 && memcmp(&original, &copied, sizeof original) == 0,
           "a copy's step (%zu modes) is its original's: x1 %.17g and %.17g", cm.modes.modes, copied.x1, original.x1);
+    contact_release_modes(&copy);
+    contact_release(&cm);
 }
 
 /* A model started on memory that held anything (here every byte 0xff,
- * NaN) runs as one started on zeros, to the bit: contact_start clears only
- * what a run uses of the springpot's arrays, and the flight of a striker
+ * NaN) runs as one started on zeros, to the bit: contact_start clears the
+ * struct and gives the springpot's arrays a zeroed block, and the flight of a striker
  * that touches at once is a step of length 0, which reads the coefficients
  * of no step length as they are. Both the fixed and the error-controlled
  * springpot, the whole impact. */
@@ -564,6 +575,8 @@ static void test_a_start_on_any_memory_runs_as_on_zeros(void)
                   && memcmp(dirty.modes.phi, clean.modes.phi, clean.modes.modes * sizeof clean.modes.phi[0]) == 0,
               "tolerance %g: a start on 0xff bytes runs as on zeros (F_peak %.17g and %.17g)", tolerances[i],
               dirty.s.F_peak, clean.s.F_peak);
+        contact_release(&dirty);
+        contact_release(&clean);
     }
 }
 
@@ -612,6 +625,10 @@ static void test_radau_same_bits_at_every_vector_width(void)
         p.damper_order = alphas[i];
         p.tolerance = 1e-8;
         contact_start(&cm, &p, v0, m);
+        memset(&wide, 0, sizeof wide);
+        memset(&narrow, 0, sizeof narrow);
+        CHECK(contact_copy_room(&wide, &cm) == 0 && contact_copy_room(&narrow, &cm) == 0, "room for copies of %zu modes",
+              cm.modes.modes);
         contact_advance_until(&cm, 1.0, CONTACT_ONSET);
         while (cm.s.in_contact && steps < 1000) {
             const double K = spring_stiffness(&cm, cm.s.n + 1), h = cm.s.n == 0 ? onset_step(&cm) : cm.s.h_next;
@@ -632,6 +649,9 @@ static void test_radau_same_bits_at_every_vector_width(void)
         }
         CHECK(steps > 10 && differ == 0, "alpha %g: %d of %d steps differ from the narrowest build's", alphas[i],
               differ, steps);
+        contact_release_modes(&wide);
+        contact_release_modes(&narrow);
+        contact_release(&cm);
     }
 }
 

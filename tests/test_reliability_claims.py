@@ -27,19 +27,66 @@ def claim(pattern):
 def test_the_memory_per_instance_is_what_an_instance_holds():
     """The resident memory per FMU instance, as fraccontact-soak measures it
     with that many instances alive, rounded to the page's digits; and the
-    page's account of it: the contact model twice (its size and its modes
-    read from the build), with less than a page of memory besides."""
-    count, kib, model, modes = claim(r"\*\*([\d,]+) instances alive at once\*\*.*? \(([\d.]+) KiB per instance: "
-                                     r"an instance holds the contact model twice, its state and its prediction of "
-                                     r"the next communication step, ([\d,]+) B each, most of it the compressed "
-                                     r"memory's arrays for (\d+) modes, whatever the damper\)")
+    page's account of it: the dashpot's contact model twice (its size read
+    from the build), with less than a page of memory besides."""
+    count, kib, model = claim(r"\*\*([\d,]+) instances alive at once\*\*.*? \(([\d.]+) KiB per instance: "
+                              r"an instance holds the contact model twice, its state and its prediction of "
+                              r"the next communication step, ([\d,]+) B each with the dashpot, which holds no "
+                              r"springpot memory\)")
     done = subprocess.run([SOAK, "instances", count.replace(",", "")], capture_output=True, text=True, check=True)
     measured = json.loads(done.stdout)
-    assert (measured["bytes_contact_model"], measured["max_modes"]) == (int(model.replace(",", "")), int(modes))
+    assert measured["bytes_contact_model"] == int(model.replace(",", ""))
     decimals = len(kib.partition(".")[2])
     assert f"{measured['kib_per_instance']:.{decimals}f}" == kib, f"measured {measured['kib_per_instance']} KiB"
     per_instance = measured["kib_per_instance"] * 1024
     assert 2 * measured["bytes_contact_model"] <= per_instance < 2 * measured["bytes_contact_model"] + 4096
+
+
+# What a springpot's FMU state adds to a dashpot's (docs/variables.md, FMU
+# state; fmu_model.c writes it): damper_order, c_alpha, memory_tolerance
+# (f64), memory (i32) and the count of the memory's values (u64), then 8 B a
+# value: x2' and the M modes (memory = 2), or v and the G1 sum one step back
+# and x2 at each step, x2(0) alone before the first (memory = 1).
+SPRINGPOT_STATE = 3 * 8 + 4 + 8
+# The compressed memory's block (model/model.c): 13 arrays of doubles, each
+# of M rounded up to whole 8 lanes; one in the model, one in its prediction.
+# malloc adds its header and alignment to each, under 32 B.
+MODE_ARRAYS, LANES, MALLOC_OVERHEAD = 13, 8, 32
+
+
+@pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                    reason="AddressSanitizer's allocator keeps its own account of the heap")
+def test_the_memory_per_configuration_is_what_an_instance_allocates():
+    """The heap bytes an initialized instance holds and its FMU state's
+    size, per configuration, as fraccontact-soak memory measures them and
+    the page writes them; a dashpot instance at most 2 KiB; and what a
+    springpot adds, from the layouts: the state 8 B a value of its memory,
+    the instance two blocks of 13 arrays of the modes padded to whole lanes,
+    so that it grows with the kernel's mode count."""
+    sizes, = claim(r"\*\*Memory per configuration\*\* \(`fraccontact-soak memory`: the heap bytes an initialized "
+                   r"FMU instance holds, malloc's own overhead included, and its serialized FMU state's size\): "
+                   r"(.*?)\. A dashpot instance holds no springpot memory: at most 2 KiB\.")
+    rows = re.findall(r"(dashpot|springpot, memory = 1 \(before its first step\)|springpot, memory = 2, "
+                      r"memory_tolerance = (\S+) \(M = (\d+)\)): ([\d,]+) B, state ([\d,]+) B", sizes)
+    done = subprocess.run([SOAK, "memory"], capture_output=True, text=True, check=True)
+    configs = json.loads(done.stdout)["configurations"]
+    n = lambda text: int(text.replace(",", ""))
+    assert [(c["damper"], c["memory"]) for c in configs[:2]] == [(1, 2), (2, 1)] and len(rows) == len(configs)
+    for (_, tolerance, modes, held, state), c in zip(rows, configs):
+        assert (n(held), n(state)) == (c["instance_bytes"], c["state_bytes"])
+        if tolerance:
+            assert (float(tolerance), int(modes)) == (c["memory_tolerance"], c["modes"])
+    dashpot, history, compressed = configs[0], configs[1], configs[2:]
+    assert dashpot["instance_bytes"] <= 2048
+    assert history["state_bytes"] == dashpot["state_bytes"] + SPRINGPOT_STATE + 8 * 4
+    assert history["instance_bytes"] == dashpot["instance_bytes"]  # no history before the first step
+    for c in compressed:
+        room = -(-c["modes"] // LANES) * LANES
+        block = MODE_ARRAYS * 8 * room
+        assert c["state_bytes"] == dashpot["state_bytes"] + SPRINGPOT_STATE + 8 * (1 + c["modes"])
+        assert 2 * block <= c["instance_bytes"] - dashpot["instance_bytes"] < 2 * (block + MALLOC_OVERHEAD)
+    assert [c["modes"] for c in compressed] == sorted({c["modes"] for c in compressed})
+    assert [c["instance_bytes"] for c in compressed] == sorted({c["instance_bytes"] for c in compressed})
 
 
 def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():

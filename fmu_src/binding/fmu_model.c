@@ -6,6 +6,7 @@
 #include <float.h>
 #include <inttypes.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <string.h>
@@ -344,7 +345,10 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
                                           "stopTime - startTime", why, sizeof why) != 0))
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_release(&fm->model);
-    contact_start(&fm->model, &fm->params, approach(&fm->in), proxy_mass(&fm->in));
+    if (contact_start(&fm->model, &fm->params, approach(&fm->in), proxy_mass(&fm->in)) != 0
+        || contact_copy_room(&fm->next.model, &fm->model) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "out of memory for the springpot's %lu modes (memory = 2)",
+                      (unsigned long)fm->model.modes.modes);
     fm->model.max_steps = MAX_STEPS;
     fm->model.s.t = t0;
     memset(&fm->step, 0, sizeof fm->step);
@@ -778,6 +782,20 @@ static const char *read_fields(fmu_model *trial, const unsigned char *bytes, siz
     return NULL;
 }
 
+/* A state read refused after trial took blocks of its own: frees them, and
+ * reports the error. */
+static fm_status refuse_state(fmu_model *fm, fmu_model *trial, const char *fmt, ...)
+{
+    char why[512];
+    va_list args;
+    contact_release_modes(&trial->model);
+    contact_release_modes(&trial->next.model);
+    va_start(args, fmt);
+    vsnprintf(why, sizeof why, fmt, args);
+    va_end(args);
+    return report(fm, FM_ERROR, "logStatusError", "%s", why);
+}
+
 fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 {
     fmu_model trial = *fm;
@@ -802,20 +820,27 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     for (i = 0; i < count; i++)
         if (!isfinite(serial_get_double(memory + 8 * i)))
             return report(fm, FM_ERROR, "logStatusError", "the FMU state's damper memory holds a non-finite value");
-    contact_configure(&trial.model, &trial.params);
+    /* the compressed memory's modes in blocks of trial's own, fm's kept
+     * until the state is read */
+    memset(&trial.model.modes, 0, sizeof trial.model.modes);
+    memset(&trial.next.model.modes, 0, sizeof trial.next.model.modes);
+    if (contact_configure(&trial.model, &trial.params) != 0 || contact_copy_room(&trial.next.model, &trial.model) != 0)
+        return refuse_state(fm, &trial, "out of memory for the FMU state's springpot modes (memory = 2)");
     trial.model.max_steps = MAX_STEPS;
     if (nonfinite_output(&trial))
-        return report(fm, FM_ERROR, "logStatusError", "the FMU state gives the output %s a non-finite value",
-                      nonfinite_output(&trial)->name);
+        return refuse_state(fm, &trial, "the FMU state gives the output %s a non-finite value",
+                            nonfinite_output(&trial)->name);
     if (contact_memory_accepts(&trial.model, count, why, sizeof why) != 0)
-        return report(fm, FM_ERROR, "logStatusError", "the FMU state does not fit its parameters: %s", why);
+        return refuse_state(fm, &trial, "the FMU state does not fit its parameters: %s", why);
     /* trial shares fm's G1 history buffer: growing it is the last thing
      * that can fail, and leaves fm as it was if it does. */
     if (contact_memory_resize(&trial.model, count) != 0)
-        return report(fm, FM_ERROR, "logStatusError", "out of memory for the FMU state's G1 history (%lu values)",
-                      (unsigned long)count);
+        return refuse_state(fm, &trial, "out of memory for the FMU state's G1 history (%lu values)",
+                            (unsigned long)count);
     for (i = 0; i < count; i++)
         contact_memory_set(&trial.model, i, serial_get_double(memory + 8 * i));
+    contact_release_modes(&fm->model);
+    contact_release_modes(&fm->next.model);
     *fm = trial;
     fm->next.valid = 0; /* a memo of the next step: the next step computes it again, to the bit */
     return FM_OK;
@@ -831,5 +856,5 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 #define FM_START
 #define FM_TIME
 #define FM_STATE
-#define FM_RELEASE(fm) contact_release(&(fm)->model)
+#define FM_RELEASE(fm) (contact_release(&(fm)->model), contact_release_modes(&(fm)->next.model))
 #include "fmu_defaults.h"
