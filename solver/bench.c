@@ -225,9 +225,14 @@ static int run_impact(const contact_params *p, double span, impact_run *out)
     char why[512];
     int failed = 0;
     contact_default_striker(&v0, &m);
-    contact_start(&cm, p, v0, m);
+    if (contact_start(&cm, p, v0, m) != 0) {
+        fprintf(stderr, "fraccontact-bench: no memory for the springpot's modes\n");
+        contact_release(&cm);
+        return -1;
+    }
     if (contact_check_advance(&cm, span > 0.0 ? calls * H : H, why, sizeof why) != 0) {
         fprintf(stderr, "fraccontact-bench: %s\n", why);
+        contact_release(&cm);
         return -1;
     }
     t0 = cpu_seconds();
