@@ -187,7 +187,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
     if (!(H > 0.0))
         return 0.0;
     carry_state(&start, &cm->s);
-    if (compressed_memory(cm))
+    if (compressed_memory(cm) && cm->modes.modes)
         memcpy(phi_start, cm->modes.phi, cm->modes.modes * sizeof *phi_start);
     while (remaining > 0.0 && !stopped && !failed) {
         double n, h, i, steps;
@@ -243,7 +243,7 @@ double contact_advance_until(contact_model *cm, double H, unsigned stop_at)
     if (failed || !state_is_finite(cm)) {
         cm->exceeded = exceeded;
         carry_state(&cm->s, &start);
-        if (compressed_memory(cm))
+        if (compressed_memory(cm) && cm->modes.modes)
             memcpy(cm->modes.phi, phi_start, cm->modes.modes * sizeof *phi_start);
         return NAN;
     }

@@ -80,6 +80,8 @@ static int memory_kernel(contact_modes *m, const contact_params *p, contact_kern
         return -1;
     m->modes = k->modes;
     m->eta = k->eta;
+    if (!k->modes) /* a kernel of no modes (alpha = 1) has no block to fill */
+        return 0;
     memcpy(m->a, k->a, k->modes * sizeof m->a[0]);
     memcpy(m->b, k->b, k->modes * sizeof m->b[0]);
     return 0;
