@@ -25,10 +25,8 @@
 
 #include "contact.h"
 #include "fmi2Functions.h"
+#include "fmu_model.h" /* the value references, from parameters.def */
 #include "guid.h"
-
-enum { VR_dt_max = 10, VR_c = 9, VR_g = 11, VR_F_peak = 15, VR_E_diss = 20, VR_eps = 21, VR_x2 = 18,
-       VR_memory_tolerance = 26, VR_damper = 33, VR_memory = 34 };
 
 static void quiet(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...)
 {
