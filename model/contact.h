@@ -52,6 +52,10 @@ enum contact_memory {
 #define CONTACT_MAX_MODES 160
 #define CONTACT_MEMORY_SPAN 1e3
 #define CONTACT_MEMORY_FLOOR 1e-9
+/* The smallest springpot order the compressed memory takes: its kernel's
+ * bounds (soe.c) are checked from here to 1 (test_springpot); towards 0 the
+ * kernel's terms lose their accuracy and the full G1 memory serves. */
+#define CONTACT_MEMORY_MIN_ORDER 1e-3
 
 /* The fixed step of dt_max = 0, the default: the paper's h20 step [s]. */
 #define CONTACT_DEFAULT_STEP 1e-7

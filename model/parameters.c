@@ -132,6 +132,11 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
         return contact_reject(msg, len, "tolerance", p->tolerance,
                               "the relative error per internal step must be 0 (fixed steps of dt_max) or lie in "
                               "[1e-12, 1e-2]");
+    if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->memory == CONTACT_MEMORY_COMPRESSED
+        && p->damper_order < CONTACT_MEMORY_MIN_ORDER)
+        return contact_reject(msg, len, "damper_order", p->damper_order,
+                              "the compressed memory (memory = 2) takes alpha >= 0.001, where its kernel holds "
+                              "memory_tolerance; below, take memory = 1 (the full G1 history)");
     if (p->damper == CONTACT_DAMPER_SPRINGPOT && p->scheme == CONTACT_SCHEME_CENTRAL)
         return contact_reject(msg, len, "scheme", p->scheme,
                               "the central differences (2) drive the dashpot only; the springpot (damper = 2) needs 1");

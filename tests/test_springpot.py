@@ -703,7 +703,7 @@ def kernel_error(alpha, tol, dt_max, points=20000):
 
 
 @pytest.mark.parametrize("tol", [1e-4, 1e-6, 1e-9])
-@pytest.mark.parametrize("alpha", [0.05, 0.3, 0.5, 0.8, 0.95, 0.999])
+@pytest.mark.parametrize("alpha", [0.001, 0.05, 0.3, 0.5, 0.8, 0.95, 0.999])
 def test_the_kernel_holds_its_tolerance_over_the_span(alpha, tol):
     """The kernel's relative error on [dt_max, 1000 s] at the default dt_max
     (1e-7, a span of 1e10) is within memory_tolerance: measured 0.40 to 0.74
@@ -907,6 +907,26 @@ def test_bad_springpot_parameters_are_refused_by_name(slave, name, value, shown)
     for _ in range(200):
         s.step(1e-5)
     assert s.get("eps") > 0
+
+
+@pytest.mark.parametrize("alpha", [9.99e-4, 1e-10, 1e-130])
+def test_the_compressed_memory_refuses_an_order_below_its_kernels_range(slave, alpha):
+    """Below alpha = 0.001, where test_the_kernel_holds_its_tolerance_over_the_span
+    stops, the compressed memory is refused naming damper_order and the
+    memory that takes it (its kernel's terms went non-finite towards 1e-30);
+    the full G1 memory runs such an order, a spring within rounding: no
+    energy gained beyond the rounding of the impact's energy."""
+    with pytest.raises(ValueError, match=rf"damper_order = {alpha:g} is invalid: .*alpha >= 0.001.*memory = 1"):
+        fraccontact.impact(damper=2, damper_order=alpha)
+    full = fraccontact.impact(damper=2, damper_order=alpha, memory=1)
+    energy = 0.5 * fraccontact.defaults()["m"] * fraccontact.defaults()["v"] ** 2
+    assert full.E_diss >= -64 * EPS * energy and full.eps <= 1.0
+    s = slave(start=False, damper=2)
+    s.enter()
+    with pytest.raises(FMICallException):
+        s.set(damper_order=alpha)
+    assert "damper_order" in s.last_error() and "memory = 1" in s.last_error(), s.last_error()
+    s.set(memory=1, damper_order=alpha)  # the instance stays usable: the full memory takes the order
 
 
 def test_too_many_modes_are_refused_naming_the_tolerance(slave):
