@@ -238,8 +238,11 @@ static int take_lines(fmu_instance *in, char *text, const char *file, const char
             return refuse("%s: a word longer than %d characters", where, MAX_TOKEN);
         if (count == 1 && strcmp(token[0], "end") == 0)
             ended = 1;
-        else if (count != 2)
-            return refuse("%s: %d words, where a line holds a name and a value (a truncated line?)", where, count);
+        else if (count == 1)
+            return refuse("%s: \"%s\" alone, where a line holds a name and a value (a truncated line?)", where,
+                          token[0]);
+        else if (count > 2)
+            return refuse("%s: %d words, where a line holds a name and a value", where, count);
         else if (!take_line(in, token, line, where))
             return 0;
     }

@@ -343,8 +343,8 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     whose values the given ones override; name: the modelName; material: words for the description;
     stop_time: the default experiment's. ValueError for a bad argument, naming it, its value and the rule."""
     if coupling == MODEL_EXCHANGE:
-        raise ValueError("coupling = model-exchange: the shipped FMUs are co-simulation FMUs; Model Exchange "
-                         "comes with issue 37 (use gauss-seidel or jacobi)")
+        raise ValueError("coupling = model-exchange: the shipped FMUs are co-simulation FMUs, without Model "
+                         "Exchange yet (use gauss-seidel or jacobi)")
     for option, value, allowed in (("scene", scene, SCENES), ("coupling", coupling, COUPLINGS),
                                    ("bodies", bodies, BODIES), ("fmi", fmi, FMU_FILES)):
         if value not in allowed or isinstance(value, bool):

@@ -1,0 +1,275 @@
+"""fraccontact export (docs/export.md): an exported FMU gives the full FMU's
+results at the same values to the last bit, passes fmpy's validation and
+fmu-manipulation-toolbox's checker, exposes only its scene's variables, and
+refuses a hostile file of fixed values at instantiation with a message
+naming the file, the line, the variable, the value and the rule."""
+
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import zipfile
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi3 import FMU3Slave
+from fmpy.validation import validate_fmu
+
+import fraccontact
+from fraccontact.export import COUPLINGS, FIXED_VALUES
+from fmu_driver import Slave
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+FMU2 = fraccontact.fmu_path("fraccontact")
+FMU3 = fraccontact.fmu_path("fraccontact-fmi3")
+STOP, INTERVAL = 3e-3, 1e-5
+
+# Configurations: (fmi, scene, bodies, coupling, values, keep). The values
+# differ from the defaults, so that an FMU ignoring its file would differ.
+CONFIGURATIONS = {
+    "fmi2-drop-dashpot-hertz": (2, "drop", 1, "gauss-seidel", dict(k=3.1e8, c=5200.0, law="hertz", v=0.7), ()),
+    "fmi3-drop-springpot": (3, "drop", 1, "gauss-seidel",
+                            dict(damper="springpot", c_alpha=2.5e5, damper_order=0.6, k=3.2e8), ("c_alpha",)),
+    "fmi2-drop-two-bodies-gravity-jacobi": (2, "drop", 2, "jacobi", dict(m2=1.5, v2=-0.1, g=9.81, c=7000.0), ()),
+    "fmi2-driven-two-bodies-springpot-jacobi": (2, "driven", 2, "jacobi",
+                                                dict(damper="springpot", memory="compressed", memory_tolerance=1e-4,
+                                                     m=0.5, m2=2.0, v=0.8, a=-3.0, g=9.81), ("memory_tolerance",)),
+    "fmi3-driven-dashpot-gravity": (3, "driven", 1, "gauss-seidel", dict(m=0.9, v=0.5, g=9.81, c=4000.0, a=2.0), ()),
+}
+
+
+def full_names(fmu):
+    return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
+
+
+def exported(tmp_path, name):
+    fmi, scene, bodies, coupling, values, keep = CONFIGURATIONS[name]
+    path = tmp_path / f"{name}.fmu"
+    out = fraccontact.export(path, scene=scene, bodies=bodies, coupling=coupling, fmi=fmi, values=values, keep=keep)
+    return path, out
+
+
+def full_values(name):
+    """What an importer sets on the full FMU for the configuration: its values, the scene's and the coupling's
+    codes."""
+    fmi, scene, bodies, coupling, values, keep = CONFIGURATIONS[name]
+    words = fraccontact.model.WORDS
+    codes = {n: words[n][x] if isinstance(x, str) else x for n, x in values.items()}
+    return dict(codes, scene=words["scene"][scene], coupling=COUPLINGS[coupling])
+
+
+def run(fmu, outputs, **start):
+    return simulate_fmu(str(fmu), start_values=start, stop_time=STOP, output_interval=INTERVAL, output=outputs,
+                        fmi_type="CoSimulation")
+
+
+@pytest.mark.parametrize("name", CONFIGURATIONS)
+def test_an_exported_fmu_gives_the_full_fmus_results_to_the_last_bit(tmp_path, name):
+    """Every output of the exported FMU, at every communication point, has
+    the bits of the full FMU's run with the same values set by the importer;
+    and the full FMU at its defaults differs (the file is read)."""
+    path, out = exported(tmp_path, name)
+    fmi = CONFIGURATIONS[name][0]
+    full = FMU2 if fmi == 2 else FMU3
+    md = read_model_description(str(path))
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    mine, theirs = run(path, outputs), run(full, outputs, **full_values(name))
+    for column in ["time"] + outputs:
+        assert mine[column].tobytes() == theirs[column].tobytes(), column
+    defaults = run(full, outputs)
+    assert defaults["F_peak"][-1] != mine["F_peak"][-1]
+
+
+@pytest.mark.parametrize("name", [name for name, c in CONFIGURATIONS.items() if c[5]])
+def test_a_kept_variable_stays_tunable_and_starts_at_its_given_value(tmp_path, name):
+    """A kept variable is in the exported modelDescription.xml with the given
+    value as its start; set to another value it gives the full FMU's run at
+    that value, bit for bit."""
+    keep = CONFIGURATIONS[name][5]
+    path, out = exported(tmp_path, name)
+    full = FMU2 if CONFIGURATIONS[name][0] == 2 else FMU3
+    variables = {v.name: v for v in read_model_description(str(path)).modelVariables}
+    given = full_values(name)
+    for n in keep:
+        assert float(variables[n].start) == given[n]
+        other = given[n] * 0.5
+        mine = run(path, ["F_peak", "x2"], **{n: other})
+        theirs = run(full, ["F_peak", "x2"], **dict(given, **{n: other}))
+        assert mine["F_peak"].tobytes() == theirs["F_peak"].tobytes()
+        assert mine["x2"].tobytes() == theirs["x2"].tobytes()
+
+
+@pytest.mark.parametrize("name", CONFIGURATIONS)
+def test_exported_fmus_pass_fmpys_validation_and_the_toolbox_checker(tmp_path, name):
+    path, out = exported(tmp_path, name)
+    assert validate_fmu(str(path)) == []
+    done = subprocess.run([str(pathlib.Path(sys.executable).parent / "fmutool"), "-input", str(path), "-check"],
+                          capture_output=True, text=True)
+    log = done.stdout + done.stderr
+    assert done.returncode == 0, log
+    assert "No semantic error" in log and "seems to be compliant" in log and "ERROR" not in log, log
+
+
+@pytest.mark.parametrize("name", CONFIGURATIONS)
+def test_the_model_structure_is_renumbered_consistently(tmp_path, name):
+    """FMI 2.0: every Unknown's index and dependency is the 1-based position
+    of the same variable in the exported ModelVariables as in the full one;
+    FMI 3.0: every reference is a value reference of an exposed variable."""
+    path, out = exported(tmp_path, name)
+    fmi = CONFIGURATIONS[name][0]
+    full = ET.fromstring(zipfile.ZipFile(FMU2 if fmi == 2 else FMU3).read("modelDescription.xml"))
+    mine = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
+
+    def unknowns(root):
+        """{(section, variable name): dependency names} of the ModelStructure."""
+        names = [v.get("name") for v in root.find("ModelVariables")]
+        by_vr = {v.get("valueReference"): v.get("name") for v in root.find("ModelVariables")}
+        name_of = (lambda i: names[int(i) - 1]) if fmi == 2 else by_vr.__getitem__
+        key = "index" if fmi == 2 else "valueReference"
+        out = {}
+        for element in root.find("ModelStructure").iter():
+            if element.get(key) is not None:
+                section = element.tag if fmi == 3 else next(s.tag for s in root.find("ModelStructure")
+                                                           if element in list(s))
+                out[section, name_of(element.get(key))] = {name_of(d) for d in
+                                                           element.get("dependencies", "").split()}
+        return out
+    exposed = set(out["variables"])
+    expected = {key: deps & exposed for key, deps in unknowns(full).items() if key[1] in exposed}
+    assert unknowns(mine) == expected
+
+
+def test_a_one_body_dashpot_from_a_fit_exposes_its_inputs_outputs_and_kept_parameters(tmp_path):
+    """fraccontact fit --json, then export --fit: the FMU has v and m, the
+    outputs a Gauss-Seidel master reads (all but F_avg_next), and c; its
+    description names the material, the fit's source and residual figures;
+    the fitted k and c are its values."""
+    fit = tmp_path / "fit.json"
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "fit", "--F-peak", "1004", "--eps", "0.59",
+                           "--height", "0.020", "--m", "0.7437", "--json"], capture_output=True, text=True,
+                          check=True)
+    fit.write_text(done.stdout)
+    fitted = json.loads(done.stdout)
+    path = tmp_path / "pp.fmu"
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "export", str(path), "--fit", str(fit), "--keep", "c",
+                           "--material", "PP"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    md = read_model_description(str(path))
+    names = {v.name for v in md.modelVariables}
+    full = full_names(FMU2)
+    outputs = {n for n, v in full.items() if v.causality == "output"}
+    assert names == {"v", "m", "c"} | (outputs - {"F_avg_next"})
+    assert len(names) == 14 < len(full) == 39
+    assert "PP" in md.description and str(fit) in md.description and "F_peak" in md.description
+    starts = {v.name: v.start for v in md.modelVariables}
+    assert float(starts["c"]) == fitted["c"] and float(starts["m"]) == 0.7437
+    text = zipfile.ZipFile(path).read(FIXED_VALUES).decode()
+    assert f"\nk {fitted['k']!r}\n" in text
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The file of fixed values, hostile.
+
+HOSTILE = [
+    ("cc 1\nend\n", 'line 1: no variable of this FMU is named "cc"'),
+    ("c 5000\nk\nend\n", 'line 2: "k" alone, where a line holds a name and a value (a truncated line?)'),
+    ("c 5000\n", 'truncated: no line "end" after line 1'),
+    ("c 5e3x\nend\n", "line 1: c = 5e3x is not a Real"),
+    ("law 1.5\nend\n", "line 1: law = 1.5 is not an Integer"),
+    ("c -1\nend\n", "line 1: c = -1 is invalid: the dashpot constant must be positive, finite and not denormal"),
+    ("law 4\nend\n", "line 1: law = 4 is invalid"),
+    ("# a comment\nc 1000\n\nc 2000\nend\n", "line 4: c = 2000: c is already set on line 2"),
+    ("F 1\nend\n", "line 1: F is an output, which has no value to fix"),
+    ("c 1 2\nend\n", "line 1: 3 words, where a line holds a name and a value"),
+    ("end\nc 1\n", 'line 2: text after the line "end"'),
+    ("c 1\0\nend\n", "holds a NUL byte"),
+    ("#" * 20000 + "\nend\n", "is larger than 16384 bytes"),
+]
+
+
+def unpacked_with(tmp_path, fmu, text):
+    """The FMU unpacked into a folder whose name has a space (a %20 in FMI 2.0's URI), its file of fixed values
+    replaced by text."""
+    folder = tmp_path / "un packed"
+    shutil.rmtree(folder, ignore_errors=True)
+    extract(str(fmu), unzipdir=str(folder))
+    (folder / "resources").mkdir(exist_ok=True)
+    (folder / FIXED_VALUES).write_bytes(text.encode())
+    return folder
+
+
+def instantiate_fmi3(md, folder):
+    messages = []
+
+    def log(env, status, category, message):
+        messages.append(message.decode())
+    fmu = FMU3Slave(guid=md.guid, unzipDirectory=str(folder), modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="hostile")
+    try:
+        fmu.instantiate(logMessage=log)
+    except Exception:
+        return messages
+    fmu.freeInstance()
+    raise AssertionError(f"instantiated: {messages}")
+
+
+@pytest.mark.parametrize("text, message", HOSTILE)
+def test_a_hostile_file_of_fixed_values_is_refused_at_instantiation(tmp_path, text, message):
+    """Both FMI versions: no instance, and an error naming the function, the
+    file, the line, the variable, the value and the rule."""
+    md = read_model_description(str(FMU2))
+    folder = unpacked_with(tmp_path, FMU2, text)
+    with pytest.raises(Exception):
+        Slave(md, str(folder), start=False, instance_name="hostile")
+    error = fraccontact.fmu._RECENT[-1][2]
+    file = folder / FIXED_VALUES
+    assert error.startswith(f"fmi2Instantiate: {file}") and message in error, error
+    md3 = read_model_description(str(FMU3))
+    folder = unpacked_with(tmp_path, FMU3, text)
+    errors = instantiate_fmi3(md3, folder)
+    assert errors and errors[-1].startswith(f"fmi3InstantiateCoSimulation: {file}") and message in errors[-1]
+
+
+def test_a_reset_sets_the_fixed_values_again(tmp_path):
+    """fmi2Reset and fmi3Reset: the instance as instantiated, its fixed
+    values set again (read through the full FMU's references)."""
+    md = read_model_description(str(FMU2))
+    folder = unpacked_with(tmp_path, FMU2, "c 5000\nlaw 2\nend\n")
+    s = Slave(md, str(folder), start=True, instance_name="reset")
+    assert (s.get("c"), s.get("law")) == (5000.0, 2)
+    s.fmu.reset()
+    s.enter()
+    assert (s.get("c"), s.get("law")) == (5000.0, 2)
+    md3 = read_model_description(str(FMU3))
+    folder = unpacked_with(tmp_path, FMU3, "c 5000\nend\n")
+    fmu = FMU3Slave(guid=md3.guid, unzipDirectory=str(folder), modelIdentifier="fraccontact", instanceName="reset")
+    fmu.instantiate()
+    c = next(v.valueReference for v in md3.modelVariables if v.name == "c")
+    fmu.reset()
+    fmu.enterInitializationMode()
+    assert fmu.getFloat64([c]) == [5000.0]
+    fmu.freeInstance()
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The command's refusals.
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--c", "-1"], "c = -1 is invalid: the dashpot constant must be positive"),
+    (["--law", "cubic"], "law = 'cubic' is invalid: it must be a whole number that fits a C int or one of g1, "
+                         "hertz, g1x"),
+    (["--coupling", "model-exchange"], "coupling = model-exchange: the shipped FMUs are co-simulation FMUs"),
+    (["--keep", "F"], "keep = 'F' is invalid: it must name a parameter or input of the FMU"),
+    (["--m2", "2"], "m2 = 2.0 is invalid with bodies = 1"),
+])
+def test_the_command_refuses_a_bad_value_and_writes_nothing(tmp_path, args, message):
+    path = tmp_path / "x.fmu"
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "export", str(path)] + args, capture_output=True,
+                          text=True)
+    assert done.returncode == 2 and message in done.stderr, done.stderr
+    assert os.listdir(tmp_path) == []
