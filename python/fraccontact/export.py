@@ -158,27 +158,29 @@ def checked_values(variables, values):
     return out
 
 
-def fit_values(path):
-    """The FMU's values in a fit's JSON output (fraccontact fit --json), and the fit itself."""
-    try:
-        fit = json.loads(pathlib.Path(path).read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise ValueError(f"--fit {path}: not a fit's JSON output ({e})") from None
-    if not isinstance(fit, dict) or "k" not in fit:
-        raise ValueError(f"--fit {path}: not a fit's JSON output (no k): write it with fraccontact fit ... --json")
-    if fit.get("family"):
-        raise ValueError(f"--fit {path}: the fit found a family of solutions, not one: fix the springpot's order "
+def fit_values(fit, source):
+    """The FMU's values in a fit (fraccontact fit --json's object, or the path of a file holding it)."""
+    named = "the fit" if isinstance(fit, dict) else f"fit = {str(fit)!r}"
+    if not isinstance(fit, dict):
+        try:
+            fit = json.loads(pathlib.Path(fit).read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+            raise ValueError(f"{named}: not a fit's JSON output ({e})") from None
+    if isinstance(fit, dict) and fit.get("family"):
+        raise ValueError(f"{named}: the fit found a family of solutions, not one: fix the springpot's order "
                          "(fraccontact fit ... --damper-order ALPHA)")
+    if not isinstance(fit, dict) or "k" not in fit:
+        raise ValueError(f"{named}: not a fit's JSON output (it has no k): write it with fraccontact fit ... --json")
     return {FIT_VALUES[key]: fit[key] for key in FIT_VALUES if fit.get(key) is not None}, fit
 
 
 def fit_summary(fit, source):
     """The fit's figures for the description: its source, the model's F_peak and eps, the residuals."""
-    parts = [f"fitted to {source}" if source else "fitted"]
-    parts += [f"{key} = {fit[key]:.6g}" for key in ("F_peak", "eps", "rms_residual") if fit.get(key) is not None]
-    parts += [f"sigma_{key} = {fit['sigma_' + key]:.3g}" for key in ("k", "c", "c_alpha", "alpha")
-              if fit.get("sigma_" + key) is not None]
-    return ", ".join(parts)
+    figures = [f"{key} = {fit[key]:.6g}" for key in ("F_peak", "eps", "rms_residual") if fit.get(key) is not None]
+    figures += [f"sigma_{key} = {fit['sigma_' + key]:.3g}" for key in ("k", "c", "c_alpha", "alpha")
+                if fit.get("sigma_" + key) is not None]
+    return (f"fitted to {source}" if source else "fitted") + (f"; the model at the fit: {', '.join(figures)}"
+                                                              if figures else "")
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -258,6 +260,7 @@ def filtered_description(root, fmi, exposed, values, name, text, stop_time):
     for interface in root.findall("ModelExchange"):
         root.remove(interface)
     root.set("modelName", name)
+    root.set("generationTool", "fraccontact export (docs/export.md)")
     root.set("description", text)
     experiment = root.find("DefaultExperiment")
     if experiment is not None and stop_time is not None:
@@ -333,14 +336,15 @@ def instantiated(md, unzipped, fmi, messages):
 
 
 def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=None, keep=(), fit=None,
-           name=None, material=None, stop_time=None):
+           source=None, name=None, material=None, stop_time=None):
     """Writes the FMU of one scene to path and returns what it holds: {"variables": the exposed names,
     "fixed": the fixed values' file text, "full_variables": the full FMU's count}.
 
     scene: drop or driven; bodies: 1 or 2 (the second body's m2 > 0 free); coupling: gauss-seidel or jacobi
     (what the master feeds: F_avg after the step, F_avg_next before it); fmi: 2 or 3; values: {name: value}
-    of the FMU's parameters and inputs; keep: names that stay tunable; fit: a fit's JSON output (a path),
-    whose values the given ones override; name: the modelName; material: words for the description;
+    of the FMU's parameters and inputs; keep: names that stay tunable; fit: a fit's JSON output (its object
+    or a file's path), whose values the given ones override; source: the fit's data, for the description
+    (default the fit's path); name: the modelName; material: words for the description;
     stop_time: the default experiment's. ValueError for a bad argument, naming it, its value and the rule."""
     if coupling == MODEL_EXCHANGE:
         raise ValueError("coupling = model-exchange: the shipped FMUs are co-simulation FMUs, without Model "
@@ -350,10 +354,14 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
         if value not in allowed or isinstance(value, bool):
             raise ValueError(f"{option} = {value!r} is invalid: it must be one of "
                              f"{', '.join(str(a) for a in allowed)}")
-    source = full_fmu(fmi)
-    _, root = description_of(source)
+    path = pathlib.Path(path)
+    if not path.parent.is_dir():
+        raise ValueError(f"path = {str(path)!r} is invalid: its folder {str(path.parent)!r} does not exist")
+    source = source if source is not None else fit if not isinstance(fit, dict) else None
+    given, fitted = fit_values(fit, source) if fit is not None else ({}, None)
+    full = full_fmu(fmi)
+    _, root = description_of(full)
     variables = variables_of(root, fmi)
-    given, fitted = fit_values(fit) if fit is not None else ({}, None)
     given.update(values or {})
     given.update(scene=SCENES[scene], coupling=COUPLINGS[coupling])
     unknown = [k for k in keep if k not in {v.name for v in variables if v.settable}]
@@ -371,10 +379,10 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
             f"{next(w for w, c in model.WORDS['law'].items() if c == checked.get('law', 1))}, {damper}, "
             + ", ".join(f"{n} = {checked[n]:.6g}" for n in ("k", "c", "c_alpha", "damper_order") if n in checked)]
     if fitted is not None:
-        what.append(fit_summary(fitted, str(fit)))
+        what.append(fit_summary(fitted, source))
     fixed = fixed_values_text(variables, exposed, checked, what)
     description = filtered_description(root, fmi, exposed, checked, name, "; ".join(what), stop_time)
-    data = fmu_bytes(source, description, fixed)
+    data = fmu_bytes(full, description, fixed)
     refused = instantiation_error(data, fmi)
     if refused:
         raise ValueError(refused)
