@@ -332,6 +332,106 @@ def instantiated(md, unzipped, fmi, messages):
 
 
 # ---------------------------------------------------------------------------------------------------------------
+# An SSP of exported FMUs.
+
+
+def registered_namespaces(data):
+    """The XML's namespace prefixes, registered so that ElementTree writes them back as they were."""
+    for _, (prefix, uri) in ET.iterparse(io.BytesIO(data), events=("start-ns",)):
+        ET.register_namespace(prefix, uri)
+
+
+def local(tag):
+    return tag.rpartition("}")[2]
+
+
+def fixed_of(fmu):
+    """{name: value text} of an exported FMU's fixed values, and the names its modelDescription.xml has."""
+    with zipfile.ZipFile(fmu) as z:
+        if FIXED_VALUES not in z.namelist():
+            raise ValueError(f"{fmu} is no exported FMU: it has no {FIXED_VALUES} (fraccontact export writes one)")
+        lines = z.read(FIXED_VALUES).decode().splitlines()
+        names = {e.get("name") for e in ET.fromstring(z.read("modelDescription.xml")).find("ModelVariables")}
+    words = (line.partition("#")[0].split() for line in lines)
+    return {w[0]: w[1] for w in words if len(w) == 2}, names
+
+
+def bound_value(parameter):
+    """An SSV parameter's value as a number."""
+    typed = next(iter(parameter))
+    text = typed.get("value")
+    return (text == "true") if local(typed.tag) == "Boolean" else float(text)
+
+
+def filter_bindings(parameter_set, component, fixed, names):
+    """Leaves out of an SSV parameter set the values the FMU fixes, each equal to its fixed value (else
+    ValueError); the number of values left."""
+    holder = next(e for e in parameter_set.iter() if local(e.tag) == "Parameters")
+    for parameter in list(holder):
+        name = parameter.get("name")
+        if name in names:
+            continue
+        if name not in fixed:
+            raise ValueError(f"the SSP sets {component}.{name}, which the exported FMU has not")
+        value, kept = bound_value(parameter), fixed[name]
+        if value != (kept == "true" if kept in ("true", "false") else float(kept)):
+            raise ValueError(f"the SSP sets {component}.{name} = {value!r}, which the exported FMU fixes at {kept}")
+        holder.remove(parameter)
+    return len(holder)
+
+
+def replace_component(ssd, files, component, fmu):
+    """The component's source made the exported FMU, its connectors checked against it, the bindings it fixes
+    left out."""
+    element = next((e for e in ssd.iter() if local(e.tag) == "Component" and e.get("name") == component), None)
+    if element is None:
+        names = [e.get("name") for e in ssd.iter() if local(e.tag) == "Component"]
+        raise ValueError(f"component = {component!r} is invalid: the SSP's components are {', '.join(names)}")
+    fixed, names = fixed_of(fmu)
+    missing = [c.get("name") for c in element.iter() if local(c.tag) == "Connector" and c.get("name") not in names]
+    if missing:
+        raise ValueError(f"the SSP connects {component}.{missing[0]}, which the exported FMU {fmu} does not expose "
+                         "(export it for this scene: --scene, --bodies, --coupling, --keep)")
+    element.set("source", f"resources/{component}.fmu")
+    files[f"resources/{component}.fmu"] = pathlib.Path(fmu).read_bytes()
+    for bindings in [e for e in element if local(e.tag) == "ParameterBindings"]:
+        for binding in list(bindings):
+            if binding.get("source"):
+                data = files[binding.get("source")]
+                registered_namespaces(data)
+                parameter_set = ET.fromstring(data)
+            else:
+                parameter_set = binding
+            left = filter_bindings(parameter_set, component, fixed, names)
+            if not left:
+                bindings.remove(binding)
+            elif binding.get("source"):
+                binding.set("source", f"resources/{component}_bindings.ssv")
+                files[binding.get("source")] = ET.tostring(parameter_set, encoding="UTF-8", xml_declaration=True)
+        if len(bindings) == 0:
+            element.remove(bindings)
+
+
+def ssp_with_contacts(ssp, contacts, out):
+    """Writes the SSP out: the SSP ssp with the FMU of each component named in contacts ({component: the
+    path of an exported FMU}) replaced by it, the values its parameter bindings set that the FMU fixes left
+    out (each must equal the fixed one), the files no component uses any longer dropped."""
+    with zipfile.ZipFile(ssp) as z:
+        files = {n: z.read(n) for n in z.namelist() if not n.endswith("/")}
+    registered_namespaces(files["SystemStructure.ssd"])
+    ssd = ET.fromstring(files["SystemStructure.ssd"])
+    for component, fmu in contacts.items():
+        replace_component(ssd, files, component, fmu)
+    used = {e.get("source") for e in ssd.iter() if e.get("source")}
+    files = {n: data for n, data in files.items() if not n.startswith("resources/") or n in used}
+    files["SystemStructure.ssd"] = ET.tostring(ssd, encoding="UTF-8", xml_declaration=True)
+    with replacing(out, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as z:
+        for name, data in files.items():
+            z.writestr(name, data)
+    return pathlib.Path(out)
+
+
+# ---------------------------------------------------------------------------------------------------------------
 # The function and the command.
 
 
@@ -414,6 +514,8 @@ def build_parser(prog=None):
     p.add_argument("--name", help="the FMU's modelName (default fraccontact_<damper>_<scene>)")
     p.add_argument("--material", help="the material and test, for the FMU's description")
     p.add_argument("--stop-time", type=float, help="the default experiment's stop time [s]")
+    p.add_argument("--ssp", nargs=3, metavar=("SSP", "COMPONENT", "OUT"),
+                   help="also write the SSP OUT: SSP with its component COMPONENT made the exported FMU")
     fmi, root = description_of(full_fmu(2))
     value_options(p, variables_of(root, fmi))
     return p
@@ -433,4 +535,15 @@ def main(argv=None, prog=None):
         return 2
     print(f"{out['path']}: {len(out['variables'])} of the full FMU's {out['full_variables']} variables: "
           f"{', '.join(out['variables'])}")
+    if args.ssp:
+        ssp, component, target = args.ssp
+        try:
+            ssp_with_contacts(ssp, {component: out["path"]}, target)
+        except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as e:
+            print(f"{parser.prog}: --ssp {ssp}: not an SSP ({e})", file=sys.stderr)
+            return 2
+        except ValueError as e:
+            print(f"{parser.prog}: --ssp {ssp}: {e}", file=sys.stderr)
+            return 2
+        print(f"{target}: {ssp} with {component} = {out['path']}")
     return 0
