@@ -7,6 +7,7 @@ naming the file, the line, the variable, the value and the rule."""
 import json
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -21,6 +22,7 @@ from fmpy.validation import validate_fmu
 
 import fraccontact
 from fraccontact.export import COUPLINGS, FIXED_VALUES
+from doc_pages import fenced_blocks
 from fmu_driver import Slave
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -272,4 +274,115 @@ def test_the_command_refuses_a_bad_value_and_writes_nothing(tmp_path, args, mess
     done = subprocess.run([sys.executable, "-m", "fraccontact", "export", str(path)] + args, capture_output=True,
                           text=True)
     assert done.returncode == 2 and message in done.stderr, done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# docs/export.md, run and measured.
+
+PAGE = (ROOT / "docs" / "export.md").read_text()
+
+
+def page_blocks(language):
+    return [body for _, lang, body in fenced_blocks(PAGE) if lang == language]
+
+
+def test_the_pages_counts_are_what_export_writes(tmp_path):
+    """The table of exposed variables per scene and bodies, for both FMI
+    versions and both couplings, and the full FMUs' counts the page names."""
+    table = PAGE.split("<!-- export-counts:begin -->")[1].split("<!-- export-counts:end -->")[0]
+    rows = re.findall(r"^\| (drop|driven) \| (\d) \| (\d+) \| (\d+) \|$", table, re.M)
+    assert len(rows) == 4
+    for scene, bodies, *counts in rows:
+        for fmi, count in zip((2, 3), counts):
+            for coupling in COUPLINGS:
+                out = fraccontact.export(tmp_path / "x.fmu", scene=scene, bodies=int(bodies), coupling=coupling,
+                                         fmi=fmi)
+                assert len(out["variables"]) == int(count), (scene, bodies, fmi, coupling)
+    assert "against the full FMU's 39 variables (FMI 2.0) and 40 (FMI 3.0" in " ".join(PAGE.split())
+    assert (len(full_names(FMU2)), len(full_names(FMU3))) == (39, 40)
+
+
+def test_the_pages_file_limit_is_the_glues():
+    header = (ROOT / "fmu_src" / "glue" / "fixed_values.h").read_text()
+    limit = re.search(r"#define FV_MAX_BYTES (\d+)", header).group(1)
+    assert f"at most {limit} bytes" in PAGE and f"more than {limit} bytes" in PAGE
+
+
+def test_the_pages_three_commands_do_what_it_says(tmp_path):
+    """The shell block run as written (the build's SSP for build/), in a
+    fresh folder; what the page says each prints; then its Python block
+    prints the figures of its comment."""
+    build = FMU2.parent
+    [block] = page_blocks("sh")
+    lines = [line for line in block.splitlines() if line.strip()]
+    assert len(lines) == 2
+    done = []
+    for line in lines:
+        command = line.replace("build/", f"{build}/").replace("fraccontact ", f"{sys.executable} -m fraccontact ", 1)
+        done.append(subprocess.run(command, shell=True, cwd=tmp_path, capture_output=True, text=True, timeout=300))
+        assert done[-1].returncode == 0, done[-1].stderr
+    fit = json.loads((tmp_path / "fit.json").read_text())
+    assert {"k", "c", "F_peak", "eps"} <= fit.keys()
+    said = re.search(r"says `(wrote pp_h20.fmu: 13 of the full FMU's 39 variables)`", " ".join(PAGE.split()))
+    assert said.group(1) in done[0].stderr
+    assert done[1].stdout.startswith("pp_contact.fmu: 14 of the full FMU's 39 variables")
+    assert "the 14 variables of `pp_contact.fmu`" in PAGE
+    assert (tmp_path / "pp_h20.fmu").is_file() and (tmp_path / "pp_drop.ssp").is_file()
+    [python] = page_blocks("python")
+    run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == python.split("# ")[-1].strip()
+
+
+def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tmp_path):
+    """The page's call: skin and hard exported for the headform scene (their
+    values from fraccontact.scenes.systems), put into build/headform.ssp;
+    fmpy runs it to every recorded value of the shipped SSP, bit for bit."""
+    from fmpy.ssp.simulation import simulate_ssp
+    from fraccontact.export import ssp_with_contacts
+    from fraccontact.scenes import systems
+    from fraccontact.ssp import bound_parameters
+    assert '"build/headform.ssp", {"skin": "skin.fmu", "hard": "hard.fmu"}' in " ".join(PAGE.split())
+    values = systems.headform_values()
+    contacts = {}
+    for component, bodies in (("skin", 2), ("hard", 1)):
+        given = {n: x for n, x in values[component].items() if n not in ("scene", "coupling")}
+        contacts[component] = tmp_path / f"{component}.fmu"
+        fraccontact.export(contacts[component], scene="driven", bodies=bodies, coupling="jacobi", values=given)
+    shipped = FMU2.parent / "headform.ssp"
+    mine = ssp_with_contacts(shipped, contacts, tmp_path / "headform_exported.ssp")
+
+    def run(ssp):
+        return simulate_ssp(str(ssp), stop_time=systems.T_END["headform"], step_size=systems.STEP["headform"],
+                            parameter_set=bound_parameters(ssp))
+    a, b = run(mine), run(shipped)
+    assert a.dtype.names == b.dtype.names
+    assert [n for n in a.dtype.names if a[n].tobytes() != b[n].tobytes()] == []
+    assert b["skin.F"].max() > 0 and b["hard.F"].max() > 0
+
+
+def test_an_ssp_binding_that_sets_a_fixed_variable_otherwise_is_refused(tmp_path):
+    """drop_test.ssp binds law = 2 on its contact: a contact exported with
+    law = 1 is refused, naming the binding and the fixed value; its SSD
+    connects F_avg_next, which a Gauss-Seidel export lacks. Nothing written."""
+    from fraccontact.export import ssp_with_contacts
+    ssp = FMU2.parent / "drop_test.ssp"
+    g1 = tmp_path / "g1.fmu"
+    fraccontact.export(g1, scene="driven", coupling="jacobi", values=dict(law=1))
+    with pytest.raises(ValueError, match=r"the SSP sets contact.law = 2.0, which the exported FMU fixes at 1"):
+        ssp_with_contacts(ssp, {"contact": g1}, tmp_path / "x.ssp")
+    gs = tmp_path / "gs.fmu"
+    fraccontact.export(gs, scene="driven", coupling="gauss-seidel", values=dict(law=2))
+    with pytest.raises(ValueError, match=r"the SSP connects contact.F_avg_next, which the exported FMU"):
+        ssp_with_contacts(ssp, {"contact": gs}, tmp_path / "x.ssp")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g1.fmu", "gs.fmu"]
+
+
+def test_fit_refuses_to_export_a_family_and_writes_nothing(tmp_path):
+    """One drop test does not determine the springpot's three constants: no FMU of a family."""
+    done = subprocess.run([sys.executable, "-m", "fraccontact", "fit", "--F-peak", "1004", "--eps", "0.59", "--height",
+                           "0.020", "--m", "0.7437", "--damper", "2", "--export-fmu", str(tmp_path / "x.fmu")],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "the fit found a family of solutions, not one" in done.stderr, done.stderr
     assert os.listdir(tmp_path) == []
