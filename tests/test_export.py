@@ -386,3 +386,50 @@ def test_fit_refuses_to_export_a_family_and_writes_nothing(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 2 and "the fit found a family of solutions, not one" in done.stderr, done.stderr
     assert os.listdir(tmp_path) == []
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The FMI Cross-Check entry.
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # fmpy 0.3.32's import of scipy.ndimage.filters
+def test_the_cross_check_entry_passes_fmpys_validator(tmp_path):
+    """export --cross-check DIR for both FMI versions: the layout for both
+    platforms, Booleans as 0/1 in the reference; fmpy's validator of vendor
+    repositories finds no problem in the FMUs nor in a result of fmpy as the
+    importer (run from the entry's _in.csv and _ref.opt, judged against
+    _ref.csv), and finds the problem of a reference naming a variable the FMU
+    has not."""
+    from fmpy.cross_check.validate_vendor_repo import read_csv, validate_repo
+    from fmpy.util import read_ref_opt_file
+    from fraccontact.export import csv_text, package_version
+    for fmi in (2, 3):
+        done = subprocess.run([sys.executable, "-m", "fraccontact", "export", str(tmp_path / f"h20_{fmi}.fmu"),
+                               "--fmi", str(fmi), "--name", "fraccontact_h20", "--cross-check", str(tmp_path)],
+                              capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+    version = package_version()
+    entries = {p.relative_to(tmp_path).as_posix() for p in tmp_path.glob("fmus/*/cs/*/fraccontact/*/*")}
+    assert entries == {f"fmus/{v}/cs/{p}/fraccontact/{version}/fraccontact_h20"
+                       for v, p in (("2.0", "linux64"), ("2.0", "win64"), ("3.0", "x86_64-linux"),
+                                    ("3.0", "x86_64-windows"))}
+    entry = tmp_path / f"fmus/2.0/cs/linux64/fraccontact/{version}/fraccontact_h20"
+    assert sorted(p.name for p in entry.iterdir()) == ["ReadMe.md", "fraccontact_h20.fmu", "fraccontact_h20_in.csv",
+                                                        "fraccontact_h20_ref.csv", "fraccontact_h20_ref.opt"]
+    reference = read_csv(entry / "fraccontact_h20_ref.csv")
+    assert set(np.unique(reference["contact"])) == {0.0, 1.0}
+    opt = read_ref_opt_file(str(entry / "fraccontact_h20_ref.opt"))
+    fmpy_version = __import__("fmpy").__version__
+    result = tmp_path / f"results/2.0/cs/linux64/fmpy/{fmpy_version}/fraccontact/{version}/fraccontact_h20"
+    result.mkdir(parents=True)
+    inputs = read_csv(entry / "fraccontact_h20_in.csv")
+    out = simulate_fmu(str(entry / "fraccontact_h20.fmu"), start_time=opt["StartTime"], stop_time=opt["StopTime"],
+                       output_interval=opt["StepSize"], input=inputs, output=list(reference.dtype.names[1:]))
+    (result / "fraccontact_h20_out.csv").write_text(csv_text(out.dtype.names, [out[n] for n in out.dtype.names]))
+    (result / "passed").write_text("")
+    fmus, results, problems = validate_repo(str(tmp_path))
+    assert (fmus, results, problems) == (4, 1, [])
+    assert "python -m fmpy.cross_check.validate_vendor_repo DIR" in PAGE and "--cross-check DIR`" in PAGE
+    bad = entry / "fraccontact_h20_ref.csv"
+    bad.write_text(bad.read_text().replace('"eps"', '"no_such_variable"', 1))
+    assert any("no_such_variable" in p for p in validate_repo(str(tmp_path))[2])
