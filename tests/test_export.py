@@ -268,6 +268,9 @@ def test_a_reset_sets_the_fixed_values_again(tmp_path):
     (["--coupling", "model-exchange"], "coupling = model-exchange: the shipped FMUs are co-simulation FMUs"),
     (["--keep", "F"], "keep = 'F' is invalid: it must name a parameter or input of the FMU"),
     (["--m2", "2"], "m2 = 2.0 is invalid with bodies = 1"),
+    # the FMU's own rules, met at the instantiation export tries
+    (["--scene", "driven", "--a", "nan"], "fmi2Instantiate: "),
+    (["--scene", "driven", "--a", "nan", "--fmi", "3"], "fmi3InstantiateCoSimulation: "),
 ])
 def test_the_command_refuses_a_bad_value_and_writes_nothing(tmp_path, args, message):
     path = tmp_path / "x.fmu"

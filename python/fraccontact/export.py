@@ -24,9 +24,11 @@ import argparse
 import io
 import json
 import math
+import numbers
 import os
 import pathlib
 import sys
+import warnings
 import xml.etree.ElementTree as ET
 import zipfile
 
@@ -119,7 +121,7 @@ def value_of(variable, given):
     naming the variable, the value and the rule."""
     words = model.WORDS.get(variable.name, {})
     if variable.type == "Real":
-        if isinstance(given, bool) or not isinstance(given, (int, float, str)):
+        if isinstance(given, bool) or not isinstance(given, (numbers.Real, str)):
             raise ValueError(f"{variable.name} = {given!r} is invalid: it must be a real number")
         try:
             return float(given)
@@ -156,7 +158,9 @@ def checked_values(variables, values):
             what = f"{name} is an output" if v is not None else f"the FMU has no variable {name}"
             raise ValueError(f"{what}: values are given to its parameters and inputs ({settable})")
         out[name] = value_of(v, given)
-    model.warning(**{n: x for n, x in out.items() if n in model.NAMES})  # ValueError where the library refuses
+    unused = model.warning(**{n: x for n, x in out.items() if n in model.NAMES})  # ValueError where refused
+    if unused:
+        warnings.warn(unused, model.ParameterWarning, stacklevel=3)
     return out
 
 
@@ -193,12 +197,14 @@ def spelled(variable, value):
     """A value as modelDescription.xml and the file of fixed values write it (repr: a Real read back to the bit)."""
     if variable.type == "Boolean":
         return "true" if value else "false"
+    if variable.type == "Real" and not math.isfinite(value):
+        return {"nan": "NaN", "inf": "INF", "-inf": "-INF"}[repr(value)]  # XML's spelling, which strtod reads
     return repr(value)
 
 
 def fixed_values_text(variables, exposed, values, title):
-    """The resources file: every hidden parameter and input at its value (given or the full FMU's start),
-    then every exposed one given a value, its start in the exported FMU."""
+    """The resources file: every hidden parameter and input at its value (given or the full FMU's start), and
+    every exposed one given a value, its start in the exported FMU; in the order of modelDescription.xml."""
     lines = [f"# {line}" for line in title] + ["# name value (fmu_src/glue/fixed_values.c reads it at "
                                                 "instantiation)"]
     for v in variables:
@@ -290,15 +296,14 @@ def instantiation_error(data, fmi):
     FMU's message refusing its fixed values."""
     import tempfile
     try:
-        from fmpy import extract, read_model_description
-        from fmpy import platform as fmpy_platform
+        from fmpy import extract, platform, platform_tuple, read_model_description
     except ImportError:
         return None
     with tempfile.TemporaryDirectory() as folder:
         path = pathlib.Path(folder, "exported.fmu")
         path.write_bytes(data)
         with zipfile.ZipFile(path) as z:
-            if not any(n.startswith(f"binaries/{fmpy_platform}/") for n in z.namelist()):
+            if not any(n.startswith(f"binaries/{platform if fmi == 2 else platform_tuple}/") for n in z.namelist()):
                 return None
         md = read_model_description(str(path))
         unzipped = extract(str(path), unzipdir=os.path.join(folder, "unzipped"))
@@ -559,7 +564,7 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     data = fmu_bytes(full, description, fixed)
     refused = instantiation_error(data, fmi)
     if refused:
-        raise ValueError(refused)
+        raise ValueError(f"the exported FMU refuses its values at instantiation: {refused}")
     with replacing(path, "wb") as f:
         f.write(data)
     return {"path": str(path), "variables": sorted(exposed), "full_variables": len(variables), "fixed": fixed}
@@ -607,9 +612,13 @@ def main(argv=None, prog=None):
     try:
         if args.cross_check is not None and args.name is not None:
             check_cross_check_name(args.name)
-        out = export(args.path, scene=args.scene, bodies=args.bodies, coupling=args.coupling, fmi=args.fmi,
-                     values=values, keep=args.keep, fit=args.fit, name=args.name, material=args.material,
-                     stop_time=args.stop_time)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always", model.ParameterWarning)
+            out = export(args.path, scene=args.scene, bodies=args.bodies, coupling=args.coupling, fmi=args.fmi,
+                         values=values, keep=args.keep, fit=args.fit, name=args.name, material=args.material,
+                         stop_time=args.stop_time)
+        for w in said:
+            print(f"{parser.prog}: warning: {w.message}", file=sys.stderr)
     except ValueError as e:
         print(f"{parser.prog}: {e}", file=sys.stderr)
         return 2
