@@ -188,6 +188,7 @@ HOSTILE = [
     ("F 1\nend\n", "line 1: F is an output, which has no value to fix"),
     ("c 1 2\nend\n", "line 1: 3 words, where a line holds a name and a value"),
     ("end\nc 1\n", 'line 2: text after the line "end"'),
+    ("guid {a}\nguid {b}\nend\n", "line 2: guid is already set on line 1"),
     ("c 1\0\nend\n", "holds a NUL byte"),
     ("#" * 20000 + "\nend\n", "is larger than 16384 bytes"),
 ]
@@ -234,6 +235,32 @@ def test_a_hostile_file_of_fixed_values_is_refused_at_instantiation(tmp_path, te
     folder = unpacked_with(tmp_path, FMU3, text)
     errors = instantiate_fmi3(md3, folder)
     assert errors and errors[-1].startswith(f"fmi3InstantiateCoSimulation: {file}") and message in errors[-1]
+
+
+def test_an_exported_fmu_has_its_own_guid_which_its_binary_takes_from_its_file(tmp_path):
+    """Each export its own GUID (the same for the same export), in its
+    modelDescription.xml and its file: the binary takes it, and refuses the
+    full FMU's GUID for that file, and the file's GUID for the full FMU."""
+    path, out = exported(tmp_path, "fmi2-drop-dashpot-hertz")
+    full = read_model_description(str(FMU2))
+    mine = read_model_description(str(path))
+    assert mine.guid != full.guid and f"\nguid {mine.guid}\nend\n" in out["fixed"]
+    second = tmp_path / "second.fmu"
+    fmi, scene, bodies, coupling, values, keep = CONFIGURATIONS["fmi2-drop-dashpot-hertz"]
+    fraccontact.export(second, scene=scene, bodies=bodies, coupling=coupling, fmi=fmi, values=values, keep=keep)
+    assert read_model_description(str(second)).guid == mine.guid
+    other = tmp_path / "other.fmu"
+    fraccontact.export(other, values=dict(c=1000.0))
+    assert read_model_description(str(other)).guid != mine.guid
+    folder = tmp_path / "unpacked"
+    extract(str(path), unzipdir=str(folder))
+    with pytest.raises(Exception):
+        Slave(full, str(folder), start=False, instance_name="full-guid")
+    assert fraccontact.fmu._RECENT[-1][2] == f"fmi2Instantiate: fmuGUID does not match modelDescription.xml ({mine.guid})"
+    folder = unpacked_with(tmp_path, FMU2, f"guid {mine.guid}\nend\n")
+    with pytest.raises(Exception):
+        Slave(full, str(folder), start=False, instance_name="file-guid")
+    assert fraccontact.fmu._RECENT[-1][2] == f"fmi2Instantiate: fmuGUID does not match modelDescription.xml ({mine.guid})"
 
 
 def test_a_reset_sets_the_fixed_values_again(tmp_path):
@@ -341,7 +368,8 @@ def test_the_pages_three_commands_do_what_it_says(tmp_path):
 def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tmp_path):
     """The page's call: skin and hard exported for the headform scene (their
     values from fraccontact.scenes.systems), put into build/headform.ssp;
-    fmpy runs it to every recorded value of the shipped SSP, bit for bit."""
+    fmpy runs it to every recorded value of the shipped SSP, bit for bit,
+    and libcosim to the same last values."""
     from fmpy.ssp.simulation import simulate_ssp
     from fraccontact.export import ssp_with_contacts
     from fraccontact.scenes import systems
@@ -363,6 +391,29 @@ def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tm
     assert a.dtype.names == b.dtype.names
     assert [n for n in a.dtype.names if a[n].tobytes() != b[n].tobytes()] == []
     assert b["skin.F"].max() > 0 and b["hard.F"].max() > 0
+    # libcosim: it applies the bindings itself and hands the FMUs its own resource URIs
+    mine, theirs = libcosim_last(mine, "headform"), libcosim_last(shipped, "headform")
+    assert mine == theirs and theirs["hard.E_diss"] > 0
+
+
+def libcosim_last(ssp, scene):
+    """The last values of the scene's recorded variables, the SSP run by libcosim over the scene's time."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from fraccontact.scenes import systems
+    log_output_level(CosimLogLevel.ERROR)
+    ex = CosimExecution.from_ssp_file(str(ssp), step_size=round(systems.STEP[scene] * 1e9))
+    observer = CosimObserver.create_last_value()
+    ex.add_observer(observer)
+    ex.simulate_until(target_time=round(systems.T_END[scene] * 1e9))
+    out = {}
+    for name in systems.RECORDED[scene]:
+        component, variable = name.split(".")
+        index = ex.slave_index_from_instance_name(component)
+        reference = {v.name.decode(): v.reference for v in ex.slave_variables(index)}[variable]
+        out[name] = observer.last_real_values(index, [reference])[0]
+    return out
 
 
 def test_an_ssp_binding_that_sets_a_fixed_variable_otherwise_is_refused(tmp_path):

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmu_vars.h"
+#include "guid.h"
 
 #define MAX_PATH_BYTES 4096
 #define MAX_TOKEN 64 /* a name's or a value's longest spelling */
@@ -22,6 +23,8 @@ typedef struct {
 struct fv_values {
     const char *context; /* while the file is read, "caller: file line n", put before the model's messages */
     fi_sink sink;        /* the instance's own, which those messages then reach */
+    char token[MAX_TOKEN + 1]; /* the exported modelDescription.xml's GUID or instantiation token ("" if none) */
+    int token_line;
     size_t count;
     fixed_value list[];
 };
@@ -191,13 +194,21 @@ static int tokens(char *line, char token[3][MAX_TOKEN + 1])
 
 #define refuse(...) (fi_fail(in, __VA_ARGS__), 0)
 
-/* One line's value, read, checked against the earlier lines, and set. */
+/* One line's value, read, checked against the earlier lines, and set
+ * (or the line "guid TOKEN", kept). */
 static int take_line(fmu_instance *in, char token[3][MAX_TOKEN + 1], int line, const char *where)
 {
     fv_values *fixed = in->fixed;
     const fmu_variable *var = named(token[0]);
     fixed_value *v = &fixed->list[fixed->count];
     size_t i;
+    if (strcmp(token[0], "guid") == 0) {
+        if (fixed->token_line)
+            return refuse("%s: guid is already set on line %d; a variable takes one line", where, fixed->token_line);
+        strcpy(fixed->token, token[1]);
+        fixed->token_line = line;
+        return 1;
+    }
     if (!var)
         return refuse("%s: no variable of this FMU is named \"%s\"", where, token[0]);
     if (var->causality == VAR_OUTPUT)
@@ -212,7 +223,7 @@ static int take_line(fmu_instance *in, char token[3][MAX_TOKEN + 1], int line, c
     v->type = var->type;
     v->line = line;
     fixed->context = where;
-    if (set_value(in->fm, v) != FM_OK)
+    if (set_value(in->fm, v) == FM_ERROR)
         return 0; /* the model said why, after `where` */
     fixed->context = NULL;
     fixed->count++;
@@ -278,11 +289,21 @@ int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller
         return refuse("%s: out of memory", caller);
     in->fixed->context = NULL;
     in->fixed->sink = in->sink;
+    in->fixed->token[0] = '\0';
+    in->fixed->token_line = 0;
     in->fixed->count = 0;
     in->sink = in_context;
     ok = take_lines(in, text, file, caller);
     in->sink = in->fixed->sink;
     return ok;
+}
+
+int fv_accepts(const fmu_instance *in, const char *token, const char *what)
+{
+    const char *expected = in->fixed && in->fixed->token[0] ? in->fixed->token : FMU_GUID;
+    if (token && strcmp(token, expected) == 0)
+        return 1;
+    return refuse("%s does not match modelDescription.xml (%s)", what, expected);
 }
 
 void fv_reset(fmu_instance *in)

@@ -1,6 +1,7 @@
 /* The values an exported FMU fixes (fraccontact export, docs/export.md):
  * resources/fixed_values.txt, one "name value" a line, '#' comments, ended
- * by a line "end". Read at instantiation and set through the model's own
+ * by a line "end"; a line "guid TOKEN" gives the exported FMU's own GUID or
+ * instantiation token. Read at instantiation and set through the model's own
  * setters, as if the importer had set them; set again at every reset. A
  * FMU without the file is the full FMU. */
 #ifndef FRACCONTACT_FIXED_VALUES_H
@@ -17,6 +18,11 @@
  * variable, the value and the rule; the values are then half set and the
  * instance is to be released. */
 int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller);
+
+/* Whether `token` (the importer's GUID or instantiation token, named
+ * `what` in the error) is the FMU's: the file's "guid" line, which an
+ * exported modelDescription.xml carries, or the full FMU's (guid.h). */
+int fv_accepts(const fmu_instance *in, const char *token, const char *what);
 
 /* fm_reset, then the fixed values again: the instance as instantiated. */
 void fv_reset(fmu_instance *in);

@@ -88,7 +88,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         fail(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
         return NULL;
     }
-    if (!fmuGUID || strcmp(fmuGUID, FMU_GUID) != 0) {
+    if (!fmuGUID) {
         fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FMU_GUID ")");
         return NULL;
     }
@@ -102,7 +102,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         free(in);
         return NULL;
     }
-    if (!fv_load(&in->base, fmuResourceLocation, 1, "fmi2Instantiate")) {
+    if (!fv_load(&in->base, fmuResourceLocation, 1, "fmi2Instantiate")
+        || !fv_accepts(&in->base, fmuGUID, "fmi2Instantiate: fmuGUID")) {
         fi_release(&in->base);
         free(in);
         return NULL;

@@ -81,7 +81,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         fail(&probe, "fmi3InstantiateCoSimulation: instanceName must be a non-empty string");
         return NULL;
     }
-    if (!instantiationToken || strcmp(instantiationToken, FMU_GUID) != 0) {
+    if (!instantiationToken) {
         fail(&probe, "fmi3InstantiateCoSimulation: instantiationToken does not match modelDescription.xml (" FMU_GUID
                      ")");
         return NULL;
@@ -104,7 +104,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         free(in);
         return NULL;
     }
-    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation")) {
+    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation")
+        || !fv_accepts(&in->base, instantiationToken, "fmi3InstantiateCoSimulation: instantiationToken")) {
         fi_release(&in->base);
         free(in);
         return NULL;

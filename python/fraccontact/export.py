@@ -28,6 +28,7 @@ import numbers
 import os
 import pathlib
 import sys
+import uuid
 import warnings
 import xml.etree.ElementTree as ET
 import zipfile
@@ -55,6 +56,7 @@ SCENE_OPTIONS = ("scene", "coupling")  # the FMU's parameters that --scene and -
 # the FMU's name; E_s follows from k, which wins over it.
 FIT_VALUES = {"k": "k", "c": "c", "c_alpha": "c_alpha", "alpha": "damper_order", "law": "law", "damper": "damper",
               "m": "m", "v": "v"}
+TOKEN = {2: "guid", 3: "instantiationToken"}  # modelDescription.xml's attribute tying it to the binary
 TYPES = {"Real": "Real", "Float64": "Real", "Integer": "Integer", "Int32": "Integer", "Boolean": "Boolean"}
 
 
@@ -215,6 +217,12 @@ def fixed_values_text(variables, exposed, values, title):
     return "\n".join(lines + ["end", ""])
 
 
+def exported_token(full, *content):
+    """The exported FMU's own GUID or instantiation token, the same for the same export: a modelDescription.xml
+    of other variables is another FMU's (importers such as libcosim keep one description per GUID)."""
+    return "{" + str(uuid.uuid5(uuid.UUID(full.strip("{}")), repr(content))) + "}"
+
+
 def renumbered(text, numbers):
     """A space-separated list of references, those in numbers mapped, the others dropped."""
     return " ".join(numbers[n] for n in text.split() if n in numbers)
@@ -251,9 +259,10 @@ def filter_structure(root, numbers, fmi):
             structure.remove(holder)
 
 
-def filtered_description(root, fmi, exposed, values, name, text, stop_time):
+def filtered_description(root, fmi, exposed, values, name, text, stop_time, token):
     """modelDescription.xml of the exported FMU: the exposed variables, their given values as starts,
-    co-simulation only, with its name, description and default experiment."""
+    co-simulation only, with its name, description, default experiment and its own GUID or instantiation
+    token."""
     variables = variables_of(root, fmi)
     holder = root.find("ModelVariables")
     numbers = {}
@@ -268,6 +277,7 @@ def filtered_description(root, fmi, exposed, values, name, text, stop_time):
     for interface in root.findall("ModelExchange"):
         root.remove(interface)
     root.set("modelName", name)
+    root.set(TOKEN[fmi], token)
     root.set("generationTool", "fraccontact export (docs/export.md)")
     root.set("description", text)
     experiment = root.find("DefaultExperiment")
@@ -560,7 +570,9 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     if fitted is not None:
         what.append(fit_summary(fitted, source))
     fixed = fixed_values_text(variables, exposed, checked, what)
-    description = filtered_description(root, fmi, exposed, checked, name, "; ".join(what), stop_time)
+    token = exported_token(root.get(TOKEN[fmi]), fixed, sorted(exposed), name, what, stop_time)
+    description = filtered_description(root, fmi, exposed, checked, name, "; ".join(what), stop_time, token)
+    fixed = fixed.replace("\nend\n", f"\nguid {token}\nend\n")
     data = fmu_bytes(full, description, fixed)
     refused = instantiation_error(data, fmi)
     if refused:
