@@ -371,7 +371,7 @@ def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tm
     fmpy runs it to every recorded value of the shipped SSP, bit for bit,
     and libcosim to the same last values."""
     from fmpy.ssp.simulation import simulate_ssp
-    from fraccontact.export import ssp_with_contacts
+    from fraccontact.ssp import with_exported
     from fraccontact.scenes import systems
     from fraccontact.ssp import bound_parameters
     assert '"build/headform.ssp", {"skin": "skin.fmu", "hard": "hard.fmu"}' in " ".join(PAGE.split())
@@ -382,7 +382,7 @@ def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tm
         contacts[component] = tmp_path / f"{component}.fmu"
         fraccontact.export(contacts[component], scene="driven", bodies=bodies, coupling="jacobi", values=given)
     shipped = FMU2.parent / "headform.ssp"
-    mine = ssp_with_contacts(shipped, contacts, tmp_path / "headform_exported.ssp")
+    mine = with_exported(shipped, contacts, tmp_path / "headform_exported.ssp")
 
     def run(ssp):
         return simulate_ssp(str(ssp), stop_time=systems.T_END["headform"], step_size=systems.STEP["headform"],
@@ -420,16 +420,16 @@ def test_an_ssp_binding_that_sets_a_fixed_variable_otherwise_is_refused(tmp_path
     """drop_test.ssp binds law = 2 on its contact: a contact exported with
     law = 1 is refused, naming the binding and the fixed value; its SSD
     connects F_avg_next, which a Gauss-Seidel export lacks. Nothing written."""
-    from fraccontact.export import ssp_with_contacts
+    from fraccontact.ssp import with_exported
     ssp = FMU2.parent / "drop_test.ssp"
     g1 = tmp_path / "g1.fmu"
     fraccontact.export(g1, scene="driven", coupling="jacobi", values=dict(law=1))
     with pytest.raises(ValueError, match=r"the SSP sets contact.law = 2.0, which the exported FMU fixes at 1"):
-        ssp_with_contacts(ssp, {"contact": g1}, tmp_path / "x.ssp")
+        with_exported(ssp, {"contact": g1}, tmp_path / "x.ssp")
     gs = tmp_path / "gs.fmu"
     fraccontact.export(gs, scene="driven", coupling="gauss-seidel", values=dict(law=2))
     with pytest.raises(ValueError, match=r"the SSP connects contact.F_avg_next, which the exported FMU"):
-        ssp_with_contacts(ssp, {"contact": gs}, tmp_path / "x.ssp")
+        with_exported(ssp, {"contact": gs}, tmp_path / "x.ssp")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["g1.fmu", "gs.fmu"]
 
 
@@ -456,7 +456,7 @@ def test_the_cross_check_entry_passes_fmpys_validator(tmp_path):
     has not."""
     from fmpy.cross_check.validate_vendor_repo import read_csv, validate_repo
     from fmpy.util import read_ref_opt_file
-    from fraccontact.export import csv_text, package_version
+    from fraccontact.cross_check import csv_text, package_version
     for fmi in (2, 3):
         done = subprocess.run([sys.executable, "-m", "fraccontact", "export", str(tmp_path / f"h20_{fmi}.fmu"),
                                "--fmi", str(fmi), "--name", "fraccontact_h20", "--cross-check", str(tmp_path)],

@@ -33,8 +33,6 @@ import warnings
 import xml.etree.ElementTree as ET
 import zipfile
 
-import numpy as np
-
 from . import fmu_path, model
 from .atomic import replacing
 from .options import OneLineParser
@@ -301,6 +299,17 @@ def fmu_bytes(source, description, fixed_text):
     return out.getvalue()
 
 
+def fixed_of(fmu):
+    """{name: value text} of an exported FMU's fixed values, and the names its modelDescription.xml has."""
+    with zipfile.ZipFile(fmu) as z:
+        if FIXED_VALUES not in z.namelist():
+            raise ValueError(f"{fmu} is no exported FMU: it has no {FIXED_VALUES} (fraccontact export writes one)")
+        lines = z.read(FIXED_VALUES).decode().splitlines()
+        names = {e.get("name") for e in ET.fromstring(z.read("modelDescription.xml")).find("ModelVariables")}
+    words = (line.partition("#")[0].split() for line in lines)
+    return {w[0]: w[1] for w in words if len(w) == 2}, names
+
+
 def instantiation_error(data, fmi):
     """The exported FMU instantiated where fmpy and a binary for this platform are at hand: None, or the
     FMU's message refusing its fixed values."""
@@ -346,178 +355,6 @@ def instantiated(md, unzipped, fmi, messages):
                     instanceName="export")
     fmu.instantiate(logMessage=log)
     return fmu
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# An SSP of exported FMUs.
-
-
-def registered_namespaces(data):
-    """The XML's namespace prefixes, registered so that ElementTree writes them back as they were."""
-    for _, (prefix, uri) in ET.iterparse(io.BytesIO(data), events=("start-ns",)):
-        ET.register_namespace(prefix, uri)
-
-
-def local(tag):
-    return tag.rpartition("}")[2]
-
-
-def fixed_of(fmu):
-    """{name: value text} of an exported FMU's fixed values, and the names its modelDescription.xml has."""
-    with zipfile.ZipFile(fmu) as z:
-        if FIXED_VALUES not in z.namelist():
-            raise ValueError(f"{fmu} is no exported FMU: it has no {FIXED_VALUES} (fraccontact export writes one)")
-        lines = z.read(FIXED_VALUES).decode().splitlines()
-        names = {e.get("name") for e in ET.fromstring(z.read("modelDescription.xml")).find("ModelVariables")}
-    words = (line.partition("#")[0].split() for line in lines)
-    return {w[0]: w[1] for w in words if len(w) == 2}, names
-
-
-def bound_value(parameter):
-    """An SSV parameter's value as a number."""
-    typed = next(iter(parameter))
-    text = typed.get("value")
-    return (text == "true") if local(typed.tag) == "Boolean" else float(text)
-
-
-def filter_bindings(parameter_set, component, fixed, names):
-    """Leaves out of an SSV parameter set the values the FMU fixes, each equal to its fixed value (else
-    ValueError); the number of values left."""
-    holder = next(e for e in parameter_set.iter() if local(e.tag) == "Parameters")
-    for parameter in list(holder):
-        name = parameter.get("name")
-        if name in names:
-            continue
-        if name not in fixed:
-            raise ValueError(f"the SSP sets {component}.{name}, which the exported FMU has not")
-        value, kept = bound_value(parameter), fixed[name]
-        if value != (kept == "true" if kept in ("true", "false") else float(kept)):
-            raise ValueError(f"the SSP sets {component}.{name} = {value!r}, which the exported FMU fixes at {kept}")
-        holder.remove(parameter)
-    return len(holder)
-
-
-def replace_component(ssd, files, component, fmu):
-    """The component's source made the exported FMU, its connectors checked against it, the bindings it fixes
-    left out."""
-    element = next((e for e in ssd.iter() if local(e.tag) == "Component" and e.get("name") == component), None)
-    if element is None:
-        names = [e.get("name") for e in ssd.iter() if local(e.tag) == "Component"]
-        raise ValueError(f"component = {component!r} is invalid: the SSP's components are {', '.join(names)}")
-    fixed, names = fixed_of(fmu)
-    missing = [c.get("name") for c in element.iter() if local(c.tag) == "Connector" and c.get("name") not in names]
-    if missing:
-        raise ValueError(f"the SSP connects {component}.{missing[0]}, which the exported FMU {fmu} does not expose "
-                         "(export it for this scene: --scene, --bodies, --coupling, --keep)")
-    element.set("source", f"resources/{component}.fmu")
-    files[f"resources/{component}.fmu"] = pathlib.Path(fmu).read_bytes()
-    for bindings in [e for e in element if local(e.tag) == "ParameterBindings"]:
-        for binding in list(bindings):
-            if binding.get("source"):
-                data = files[binding.get("source")]
-                registered_namespaces(data)
-                parameter_set = ET.fromstring(data)
-            else:
-                parameter_set = binding
-            left = filter_bindings(parameter_set, component, fixed, names)
-            if not left:
-                bindings.remove(binding)
-            elif binding.get("source"):
-                binding.set("source", f"resources/{component}_bindings.ssv")
-                files[binding.get("source")] = ET.tostring(parameter_set, encoding="UTF-8", xml_declaration=True)
-        if len(bindings) == 0:
-            element.remove(bindings)
-
-
-def ssp_with_contacts(ssp, contacts, out):
-    """Writes the SSP out: the SSP ssp with the FMU of each component named in contacts ({component: the
-    path of an exported FMU}) replaced by it, the values its parameter bindings set that the FMU fixes left
-    out (each must equal the fixed one), the files no component uses any longer dropped."""
-    with zipfile.ZipFile(ssp) as z:
-        files = {n: z.read(n) for n in z.namelist() if not n.endswith("/")}
-    registered_namespaces(files["SystemStructure.ssd"])
-    ssd = ET.fromstring(files["SystemStructure.ssd"])
-    for component, fmu in contacts.items():
-        replace_component(ssd, files, component, fmu)
-    used = {e.get("source") for e in ssd.iter() if e.get("source")}
-    files = {n: data for n, data in files.items() if not n.startswith("resources/") or n in used}
-    files["SystemStructure.ssd"] = ET.tostring(ssd, encoding="UTF-8", xml_declaration=True)
-    with replacing(out, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as z:
-        for name, data in files.items():
-            z.writestr(name, data)
-    return pathlib.Path(out)
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# The FMI Cross-Check entry.
-
-# The platforms of the Cross-Check's layout, by FMI version, as the FMUs' binaries/ folders name them.
-CROSS_CHECK_PLATFORMS = {2: ("linux64", "win64"), 3: ("x86_64-linux", "x86_64-windows")}
-
-
-def package_version():
-    """The package's version: the installed distribution's, else the source tree's pyproject.toml."""
-    import importlib.metadata
-    try:
-        return importlib.metadata.version("fraccontact")
-    except importlib.metadata.PackageNotFoundError:
-        import tomllib
-        return tomllib.loads((pathlib.Path(__file__).parents[2] / "pyproject.toml").read_text())["project"]["version"]
-
-
-def csv_text(names, columns):
-    """A CSV the Cross-Check reads: a header of names, numbers written to the bit, Booleans as 0 and 1."""
-    rows = [",".join(f'"{n}"' for n in names)]
-    for values in zip(*columns):
-        rows.append(",".join(str(int(x)) if isinstance(x, (bool, np.bool_)) else repr(float(x)) for x in values))
-    return "\n".join(rows) + "\n"
-
-
-def check_cross_check_name(name):
-    if not (name.replace("_", "").isalnum() and name.isascii()):
-        raise ValueError(f"name = {name!r} is invalid for the Cross-Check: it names a folder and a file, so it "
-                         "must be letters, digits and '_'")
-
-
-def cross_check_entry(fmu, folder):
-    """Writes the FMI Cross-Check entry of the FMU under folder, for each platform it has binaries for:
-    fmus/<FMI version>/cs/<platform>/fraccontact/<version>/<model>/ with <model>.fmu, <model>_ref.csv
-    (fmpy's run of it from its default experiment), <model>_in.csv (its inputs, held at their start
-    values), <model>_ref.opt and ReadMe.md. The folders written."""
-    from fmpy import read_model_description, simulate_fmu
-    md = read_model_description(str(fmu))
-    model = md.modelName
-    check_cross_check_name(model)
-    experiment = md.defaultExperiment
-    start, stop, step = (float(experiment.startTime or 0), float(experiment.stopTime), float(experiment.stepSize))
-    outputs = [v for v in md.modelVariables if v.causality == "output"]
-    inputs = [v for v in md.modelVariables if v.causality == "input"]
-    result = simulate_fmu(str(fmu), start_time=start, stop_time=stop, output_interval=step,
-                          output=[v.name for v in outputs], fmi_type="CoSimulation")
-    reference = csv_text(["time"] + [v.name for v in outputs], [result["time"]] + [result[v.name] for v in outputs])
-    held = csv_text(["time"] + [v.name for v in inputs], [[start, stop]] + [[float(v.start)] * 2 for v in inputs])
-    options = f"StepSize,{step!r}\nStartTime,{start!r}\nStopTime,{stop!r}\nRelTol,0.0001\n"
-    readme = (f"# {model}\n\n{md.description}\n\nWritten by `fraccontact export --cross-check` "
-              f"(fraccontact {package_version()}, docs/export.md): the reference is fmpy's run of this FMU on "
-              f"x86_64 Linux from {start:g} s to {stop:g} s, a communication step of {step:g} s, its inputs held "
-              "at their start values.\n")
-    with zipfile.ZipFile(fmu) as z:
-        binaries = {n.split("/")[1] for n in z.namelist() if n.startswith("binaries/") and n.count("/") >= 2}
-    fmi = md.fmiVersion
-    written = []
-    for platform in CROSS_CHECK_PLATFORMS[int(fmi[0])]:
-        if platform not in binaries:
-            continue
-        entry = pathlib.Path(folder, "fmus", fmi, "cs", platform, "fraccontact", package_version(), model)
-        entry.mkdir(parents=True, exist_ok=True)
-        with replacing(entry / f"{model}.fmu", "wb") as f:
-            f.write(pathlib.Path(fmu).read_bytes())
-        for name, text in ((f"{model}_ref.csv", reference), (f"{model}_in.csv", held),
-                           (f"{model}_ref.opt", options), ("ReadMe.md", readme)):
-            with replacing(entry / name) as f:
-                f.write(text)
-        written.append(entry)
-    return written
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -621,9 +458,10 @@ def main(argv=None, prog=None):
               if key.startswith("value_") and text is not None}
     if args.cross_check is not None and not args.cross_check.is_dir():
         parser.error(f"--cross-check {args.cross_check}: no such folder")
+    from .cross_check import check_name, entry
     try:
         if args.cross_check is not None and args.name is not None:
-            check_cross_check_name(args.name)
+            check_name(args.name)
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always", model.ParameterWarning)
             out = export(args.path, scene=args.scene, bodies=args.bodies, coupling=args.coupling, fmi=args.fmi,
@@ -637,9 +475,10 @@ def main(argv=None, prog=None):
     print(f"{out['path']}: {len(out['variables'])} of the full FMU's {out['full_variables']} variables: "
           f"{', '.join(out['variables'])}")
     if args.ssp:
+        from .ssp import with_exported
         ssp, component, target = args.ssp
         try:
-            ssp_with_contacts(ssp, {component: out["path"]}, target)
+            with_exported(ssp, {component: out["path"]}, target)
         except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as e:
             print(f"{parser.prog}: --ssp {ssp}: not an SSP ({e})", file=sys.stderr)
             return 2
@@ -648,6 +487,6 @@ def main(argv=None, prog=None):
             return 2
         print(f"{target}: {ssp} with {component} = {out['path']}")
     if args.cross_check:
-        for entry in cross_check_entry(out["path"], args.cross_check):
-            print(f"{entry}: the Cross-Check entry")
+        for folder in entry(out["path"], args.cross_check):
+            print(f"{folder}: the Cross-Check entry")
     return 0
