@@ -180,6 +180,23 @@ def fit_values(fit, source):
     return {FIT_VALUES[key]: fit[key] for key in FIT_VALUES if fit.get(key) is not None}, fit
 
 
+def word(name, values):
+    """The word of an enumerated parameter's value (its default where not given)."""
+    code = values.get(name, model.defaults()[name])
+    return next(w for w, c in model.WORDS[name].items() if c == code)
+
+
+def described(values, scene, bodies, coupling, material):
+    """The description's first part: the material, the scene, the law, the damper, k and the damper's
+    constants."""
+    default = model.defaults()
+    names = ("k", "c") if word("damper", values) == "dashpot" else ("k", "c_alpha", "damper_order")
+    constants = ", ".join(f"{n} = {values.get(n, default[n]):.6g}" for n in names)
+    return [f"fraccontact contact{' of ' + material if material else ''}, exported for the {scene} scene with "
+            f"{bodies} bod{'y' if bodies == 1 else 'ies'} and the {coupling} coupling: law {word('law', values)}, "
+            f"{word('damper', values)}, {constants}"]
+
+
 def fit_summary(fit, source):
     """The fit's figures for the description: its source, the model's F_peak and eps, the residuals."""
     figures = [f"{key} = {fit[key]:.6g}" for key in ("F_peak", "eps", "rms_residual") if fit.get(key) is not None]
@@ -392,18 +409,17 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     given.update(scene=SCENES[scene], coupling=COUPLINGS[coupling])
     unknown = [k for k in keep if k not in {v.name for v in variables if v.settable}]
     if unknown:
-        raise ValueError(f"keep = {unknown[0]!r} is invalid: it must name a parameter or input of the FMU (its outputs are all exposed)")
+        raise ValueError(f"keep = {unknown[0]!r} is invalid: it must name a parameter or input of the FMU (its "
+                         "outputs are all exposed)")
+    if stop_time is not None and not (isinstance(stop_time, numbers.Real) and 0 < stop_time < math.inf):
+        raise ValueError(f"stop_time = {stop_time!r} is invalid: it must be a positive, finite time [s]")
     checked = checked_values(variables, given)
     if bodies == 1 and checked.get("m2", 0) != 0:
         raise ValueError(f"m2 = {checked['m2']!r} is invalid with bodies = 1: a second body of mass m2 > 0 is "
                          "bodies = 2")
     exposed = exposed_names(variables, SCENES[scene], bodies, COUPLINGS[coupling], set(keep))
-    damper = next(w for w, c in model.WORDS["damper"].items() if c == checked.get("damper", 1))
-    name = name or f"fraccontact_{damper}_{scene}"
-    what = [f"fraccontact contact{' of ' + material if material else ''}, exported for the {scene} scene with "
-            f"{bodies} bod{'y' if bodies == 1 else 'ies'} and the {coupling} coupling: law "
-            f"{next(w for w, c in model.WORDS['law'].items() if c == checked.get('law', 1))}, {damper}, "
-            + ", ".join(f"{n} = {checked[n]:.6g}" for n in ("k", "c", "c_alpha", "damper_order") if n in checked)]
+    what = described(checked, scene, bodies, coupling, material)
+    name = name or f"fraccontact_{word('damper', checked)}_{scene}"
     if fitted is not None:
         what.append(fit_summary(fitted, source))
     fixed = fixed_values_text(variables, exposed, checked, what)
