@@ -344,7 +344,7 @@ def test_the_pages_three_commands_do_what_it_says(tmp_path):
     fresh folder; what the page says each prints; then its Python block
     prints the figures of its comment."""
     build = FMU2.parent
-    [block] = page_blocks("sh")
+    block = page_blocks("sh")[0]
     lines = [line for line in block.splitlines() if line.strip()]
     assert len(lines) == 2
     done = []
@@ -359,30 +359,37 @@ def test_the_pages_three_commands_do_what_it_says(tmp_path):
     assert done[1].stdout.startswith("pp_contact.fmu: 14 of the full FMU's 39 variables")
     assert "the 14 variables of `pp_contact.fmu`" in PAGE
     assert (tmp_path / "pp_h20.fmu").is_file() and (tmp_path / "pp_drop.ssp").is_file()
-    [python] = page_blocks("python")
+    python = page_blocks("python")[0]
     run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip() == python.split("# ")[-1].strip()
 
 
 def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tmp_path):
-    """The page's call: skin and hard exported for the headform scene (their
-    values from fraccontact.scenes.systems), put into build/headform.ssp;
-    fmpy runs it to every recorded value of the shipped SSP, bit for bit,
-    and libcosim to the same last values."""
+    """The page's Python block (the build's SSP for build/), then its
+    command: fraccontact scene headform --ssp prints the shipped scene's
+    figures; fmpy runs every recorded value of both SSPs bit for bit, and
+    libcosim to the same last values; the page's refusal, as it words it."""
     from fmpy.ssp.simulation import simulate_ssp
-    from fraccontact.ssp import with_exported
     from fraccontact.scenes import systems
     from fraccontact.ssp import bound_parameters
-    assert '"build/headform.ssp", {"skin": "skin.fmu", "hard": "hard.fmu"}' in " ".join(PAGE.split())
-    values = systems.headform_values()
-    contacts = {}
-    for component, bodies in (("skin", 2), ("hard", 1)):
-        given = {n: x for n, x in values[component].items() if n not in ("scene", "coupling")}
-        contacts[component] = tmp_path / f"{component}.fmu"
-        fraccontact.export(contacts[component], scene="driven", bodies=bodies, coupling="jacobi", values=given)
     shipped = FMU2.parent / "headform.ssp"
-    mine = with_exported(shipped, contacts, tmp_path / "headform_exported.ssp")
+    block = page_blocks("python")[1].replace('"build/', f'"{FMU2.parent}/')
+    done = subprocess.run([sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    mine = tmp_path / "headform_exported.ssp"
+    command = page_blocks("sh")[1].split()
+    assert command == ["fraccontact", "scene", "headform", "--ssp", "headform_exported.ssp"]
+
+    def scene(*args):
+        done = subprocess.run([sys.executable, "-m", "fraccontact", "scene", "headform", *args], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=300)
+        return done.returncode, done.stdout, done.stderr
+    exported, theirs = scene(*command[3:]), scene()
+    assert exported[0] == 0 and exported[1] == theirs[1], exported[2]
+    refused = scene(*command[3:], "--gap0", "0.05")
+    said = re.search(r"`(hard\.gap0 = 0\.05 is set, but the exported FMU fixes it at 0\.065)`", " ".join(PAGE.split()))
+    assert refused[0] == 2 and said.group(1) in refused[2], refused[2]
 
     def run(ssp):
         return simulate_ssp(str(ssp), stop_time=systems.T_END["headform"], step_size=systems.STEP["headform"],
@@ -424,7 +431,7 @@ def test_an_ssp_binding_that_sets_a_fixed_variable_otherwise_is_refused(tmp_path
     ssp = FMU2.parent / "drop_test.ssp"
     g1 = tmp_path / "g1.fmu"
     fraccontact.export(g1, scene="driven", coupling="jacobi", values=dict(law=1))
-    with pytest.raises(ValueError, match=r"the SSP sets contact.law = 2.0, which the exported FMU fixes at 1"):
+    with pytest.raises(ValueError, match=r"contact.law = 2.0 is set, but the exported FMU fixes it at 1"):
         with_exported(ssp, {"contact": g1}, tmp_path / "x.ssp")
     gs = tmp_path / "gs.fmu"
     fraccontact.export(gs, scene="driven", coupling="gauss-seidel", values=dict(law=2))

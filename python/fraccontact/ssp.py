@@ -22,7 +22,7 @@ import numpy as np
 from . import fmu_path
 from .atomic import replacing
 from .cosim import M, V0
-from .export import fixed_of
+from .export import FIXED_VALUES, fixed_of
 
 T_END = 3e-3  # the SSD's DefaultExperiment: the impact and the rebound
 
@@ -124,21 +124,43 @@ def bound_value(parameter):
     return (text == "true") if local(typed.tag) == "Boolean" else float(text)
 
 
+def exposed(component, name, value, fixed, names):
+    """Whether the exported FMU of component exposes name: else it must fix it at value (else ValueError)."""
+    if name in names:
+        return True
+    if name not in fixed:
+        raise ValueError(f"{component}.{name} is set, which the exported FMU has not")
+    kept = fixed[name]
+    if value != (kept == "true" if kept in ("true", "false") else float(kept)):
+        raise ValueError(f"{component}.{name} = {value!r} is set, but the exported FMU fixes it at {kept}")
+    return False
+
+
 def filter_bindings(parameter_set, component, fixed, names):
     """Leaves out of an SSV parameter set the values the FMU fixes, each equal to its fixed value (else
     ValueError); the number of values left."""
     holder = next(e for e in parameter_set.iter() if local(e.tag) == "Parameters")
     for parameter in list(holder):
-        name = parameter.get("name")
-        if name in names:
-            continue
-        if name not in fixed:
-            raise ValueError(f"the SSP sets {component}.{name}, which the exported FMU has not")
-        value, kept = bound_value(parameter), fixed[name]
-        if value != (kept == "true" if kept in ("true", "false") else float(kept)):
-            raise ValueError(f"the SSP sets {component}.{name} = {value!r}, which the exported FMU fixes at {kept}")
-        holder.remove(parameter)
+        if not exposed(component, parameter.get("name"), bound_value(parameter), fixed, names):
+            holder.remove(parameter)
     return len(holder)
+
+
+def exposed_values(ssp, values):
+    """{component: {name: value}} of values that the SSP's FMUs expose: a value its exported FMUs fix is left
+    out, each equal to the fixed one (else ValueError). What a master sets on the SSP of a scene."""
+    with zipfile.ZipFile(ssp) as z:
+        ssd = ET.fromstring(z.read("SystemStructure.ssd"))
+        sources = {e.get("name"): e.get("source") for e in ssd.iter() if local(e.tag) == "Component"}
+        fmus = {component: io.BytesIO(z.read(sources[component])) for component in values}
+    out = {}
+    for component, given in values.items():
+        if FIXED_VALUES not in zipfile.ZipFile(fmus[component]).namelist():
+            out[component] = dict(given)
+            continue
+        fixed, names = fixed_of(fmus[component])
+        out[component] = {n: x for n, x in given.items() if exposed(component, n, x, fixed, names)}
+    return out
 
 
 def replace_component(ssd, files, component, fmu):
