@@ -188,7 +188,7 @@ HOSTILE = [
     ("F 1\nend\n", "line 1: F is an output, which has no value to fix"),
     ("c 1 2\nend\n", "line 1: 3 words, where a line holds a name and a value"),
     ("end\nc 1\n", 'line 2: text after the line "end"'),
-    ("guid {a}\nguid {b}\nend\n", "line 2: guid is already set on line 1"),
+    ("guid {a}\nguid {b}\nend\n", "line 2: guid is already set on line 1; it takes one line"),
     ("c 1\0\nend\n", "holds a NUL byte"),
     ("#" * 20000 + "\nend\n", "is larger than 16384 bytes"),
 ]
@@ -240,7 +240,8 @@ def test_a_hostile_file_of_fixed_values_is_refused_at_instantiation(tmp_path, te
 def test_an_exported_fmu_has_its_own_guid_which_its_binary_takes_from_its_file(tmp_path):
     """Each export its own GUID (the same for the same export), in its
     modelDescription.xml and its file: the binary takes it, and refuses the
-    full FMU's GUID for that file, and the file's GUID for the full FMU."""
+    full FMU's GUID for that file, the file's GUID for the full FMU, and the
+    exported FMU whose file was removed."""
     path, out = exported(tmp_path, "fmi2-drop-dashpot-hertz")
     full = read_model_description(str(FMU2))
     mine = read_model_description(str(path))
@@ -261,6 +262,14 @@ def test_an_exported_fmu_has_its_own_guid_which_its_binary_takes_from_its_file(t
     with pytest.raises(Exception):
         Slave(full, str(folder), start=False, instance_name="file-guid")
     assert fraccontact.fmu._RECENT[-1][2] == f"fmi2Instantiate: fmuGUID does not match modelDescription.xml ({mine.guid})"
+    # an exported FMU whose file was removed: its GUID is unknown to the binary
+    folder = tmp_path / "unpacked"
+    (folder / FIXED_VALUES).unlink()
+    with pytest.raises(Exception):
+        Slave(mine, str(folder), start=False, instance_name="no-file")
+    assert fraccontact.fmu._RECENT[-1][2] == (f"fmi2Instantiate: fmuGUID does not match modelDescription.xml "
+                                             f"({full.guid}; an exported FMU names its own in "
+                                             f"resources/fixed_values.txt, which this FMU has not)")
 
 
 def test_a_reset_sets_the_fixed_values_again(tmp_path):

@@ -204,7 +204,7 @@ static int take_line(fmu_instance *in, char token[3][MAX_TOKEN + 1], int line, c
     size_t i;
     if (strcmp(token[0], "guid") == 0) {
         if (fixed->token_line)
-            return refuse("%s: guid is already set on line %d; a variable takes one line", where, fixed->token_line);
+            return refuse("%s: guid is already set on line %d; it takes one line", where, fixed->token_line);
         strcpy(fixed->token, token[1]);
         fixed->token_line = line;
         return 1;
@@ -303,6 +303,9 @@ int fv_accepts(const fmu_instance *in, const char *token, const char *what)
     const char *expected = in->fixed && in->fixed->token[0] ? in->fixed->token : FMU_GUID;
     if (token && strcmp(token, expected) == 0)
         return 1;
+    if (!in->fixed) /* an exported FMU whose file was removed lands here too */
+        return refuse("%s does not match modelDescription.xml (%s; an exported FMU names its own in "
+                      "resources/" FV_FILE ", which this FMU has not)", what, expected);
     return refuse("%s does not match modelDescription.xml (%s)", what, expected);
 }
 
