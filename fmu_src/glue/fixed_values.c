@@ -14,20 +14,26 @@
 #define MAX_TOKEN 64 /* a name's or a value's longest spelling */
 
 typedef struct {
+    double value; /* an Integer's or a Boolean's too: every int is a double exactly */
     unsigned vr;
     var_type type;
-    double value; /* an Integer's or a Boolean's too: every int is a double exactly */
-    int line;
 } fixed_value;
 
+/* The values a reset sets again: those that changed the model's start. */
 struct fv_values {
     const char *context; /* while the file is read, "caller: file line n", put before the model's messages */
     fi_sink sink;        /* the instance's own, which those messages then reach */
-    char token[MAX_TOKEN + 1]; /* the exported modelDescription.xml's GUID or instantiation token ("" if none) */
-    int token_line;
     size_t count;
     fixed_value list[];
 };
+
+/* What reading the file keeps besides: the line each variable was set on
+ * (0: none; by its place in the table), the file's guid and its line. */
+typedef struct {
+    int *lines;
+    char token[MAX_TOKEN + 1];
+    int token_line;
+} reading;
 
 static void in_context(const fmu_instance *in, fi_status status, const char *category, const char *message)
 {
@@ -159,6 +165,21 @@ static const char *const type_rules[] = {"a Real (as C's strtod reads it)", "an 
 
 static int (*const type_readers[])(const char *, double *) = {real_value, integer_value, boolean_value};
 
+/* Whether the model holds the value already (its start, where the table's
+ * offset says, as fmu_defaults.h reads it): a reset need not set it again. */
+static int held(const fmu_model *fm, const fmu_variable *var, double value)
+{
+    const char *at = (const char *)fm + var->offset;
+    double real;
+    int n;
+    if (var->type == VAR_REAL) {
+        memcpy(&real, at, sizeof real);
+        return memcmp(&real, &value, sizeof real) == 0;
+    }
+    memcpy(&n, at, sizeof n);
+    return n == (int)value;
+}
+
 static fm_status set_value(fmu_model *fm, const fixed_value *v)
 {
     if (v->type == VAR_REAL)
@@ -193,35 +214,38 @@ static int tokens(char *line, char token[3][MAX_TOKEN + 1])
 }
 
 #define refuse(...) (fi_fail(in, __VA_ARGS__), 0)
+#define refuse_file(...) (fi_fail(in, __VA_ARGS__), -1)
 
 /* One line's value, read, checked against the earlier lines, and set
  * (or the line "guid TOKEN", kept). */
-static int take_line(fmu_instance *in, char token[3][MAX_TOKEN + 1], int line, const char *where)
+static int take_line(fmu_instance *in, reading *r, char token[3][MAX_TOKEN + 1], int line, const char *where)
 {
     fv_values *fixed = in->fixed;
     const fmu_variable *var = named(token[0]);
     fixed_value *v = &fixed->list[fixed->count];
-    size_t i;
+    int *first;
     if (strcmp(token[0], "guid") == 0) {
-        if (fixed->token_line)
-            return refuse("%s: guid is already set on line %d; it takes one line", where, fixed->token_line);
-        strcpy(fixed->token, token[1]);
-        fixed->token_line = line;
+        if (r->token_line)
+            return refuse("%s: guid is already set on line %d; it takes one line", where, r->token_line);
+        strcpy(r->token, token[1]);
+        r->token_line = line;
         return 1;
     }
     if (!var)
         return refuse("%s: no variable of this FMU is named \"%s\"", where, token[0]);
     if (var->causality == VAR_OUTPUT)
         return refuse("%s: %s is an output, which has no value to fix", where, var->name);
-    for (i = 0; i < fixed->count; i++)
-        if (fixed->list[i].vr == var->vr && fixed->list[i].type == var->type)
-            return refuse("%s: %s = %s: %s is already set on line %d; a variable takes one line", where, var->name,
-                          token[1], var->name, fixed->list[i].line);
+    first = &r->lines[var - fm_variables()->list];
+    if (*first)
+        return refuse("%s: %s = %s: %s is already set on line %d; a variable takes one line", where, var->name,
+                      token[1], var->name, *first);
     if (!type_readers[var->type](token[1], &v->value))
         return refuse("%s: %s = %s is not %s", where, var->name, token[1], type_rules[var->type]);
+    *first = line;
     v->vr = var->vr;
     v->type = var->type;
-    v->line = line;
+    if (held(in->fm, var, v->value))
+        return 1;
     fixed->context = where;
     if (set_value(in->fm, v) == FM_ERROR)
         return 0; /* the model said why, after `where` */
@@ -231,7 +255,7 @@ static int take_line(fmu_instance *in, char token[3][MAX_TOKEN + 1], int line, c
 }
 
 /* Every line of the file's text: its values set, until the line "end". */
-static int take_lines(fmu_instance *in, char *text, const char *file, const char *caller)
+static int take_lines(fmu_instance *in, reading *r, char *text, const char *file, const char *caller)
 {
     char token[3][MAX_TOKEN + 1], where[MAX_PATH_BYTES + 128];
     int line = 0, ended = 0, count;
@@ -254,7 +278,7 @@ static int take_lines(fmu_instance *in, char *text, const char *file, const char
                           token[0]);
         else if (count > 2)
             return refuse("%s: %d words, where a line holds a name and a value", where, count);
-        else if (!take_line(in, token, line, where))
+        else if (!take_line(in, r, token, line, where))
             return 0;
     }
     if (!ended)
@@ -262,51 +286,76 @@ static int take_lines(fmu_instance *in, char *text, const char *file, const char
     return 1;
 }
 
-int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller)
+/* Whether the importer's token (named `what`) is the FMU's: the file's guid,
+ * or the full FMU's where the file names none. */
+static int token_accepted(const fmu_instance *in, const char *token, const char *file_token, const char *what)
 {
-    char file[MAX_PATH_BYTES + 32], text[FV_MAX_BYTES + 1];
-    size_t n;
-    int error, ok;
-    FILE *f;
-    if (!file_path(resources, uri, file, sizeof file))
-        return 1;
-    f = fopen(file, "rb");
-    if (!f)
-        return errno == ENOENT || errno == ENOTDIR ? 1 : refuse("%s: %s cannot be opened: %s", caller, file,
-                                                                strerror(errno));
-    n = fread(text, 1, sizeof text, f);
-    error = ferror(f);
-    fclose(f);
-    if (error)
-        return refuse("%s: %s cannot be read", caller, file);
-    if (n > FV_MAX_BYTES)
-        return refuse("%s: %s is larger than %d bytes: no file of fixed values is", caller, file, FV_MAX_BYTES);
-    if (memchr(text, '\0', n))
-        return refuse("%s: %s holds a NUL byte: it is no text", caller, file);
-    text[n] = '\0';
-    in->fixed = malloc(sizeof *in->fixed + fm_variables()->count * sizeof in->fixed->list[0]);
-    if (!in->fixed)
-        return refuse("%s: out of memory", caller);
-    in->fixed->context = NULL;
-    in->fixed->sink = in->sink;
-    in->fixed->token[0] = '\0';
-    in->fixed->token_line = 0;
-    in->fixed->count = 0;
-    in->sink = in_context;
-    ok = take_lines(in, text, file, caller);
-    in->sink = in->fixed->sink;
-    return ok;
-}
-
-int fv_accepts(const fmu_instance *in, const char *token, const char *what)
-{
-    const char *expected = in->fixed && in->fixed->token[0] ? in->fixed->token : FMU_GUID;
+    const char *expected = file_token[0] ? file_token : FMU_GUID;
     if (token && strcmp(token, expected) == 0)
         return 1;
     if (!in->fixed) /* an exported FMU whose file was removed lands here too */
         return refuse("%s does not match modelDescription.xml (%s; an exported FMU names its own in "
                       "resources/" FV_FILE ", which this FMU has not)", what, expected);
     return refuse("%s does not match modelDescription.xml (%s)", what, expected);
+}
+
+/* The file's text read whole into text (FV_MAX_BYTES + 1 bytes): 1, 0 where
+ * there is none, -1 after an error. */
+static int read_text(fmu_instance *in, const char *file, char *text, const char *caller)
+{
+    size_t n;
+    int error;
+    FILE *f = fopen(file, "rb");
+    if (!f)
+        return errno == ENOENT || errno == ENOTDIR ? 0 : refuse_file("%s: %s cannot be opened: %s", caller, file,
+                                                                     strerror(errno));
+    n = fread(text, 1, FV_MAX_BYTES + 1, f);
+    error = ferror(f);
+    fclose(f);
+    if (error)
+        return refuse_file("%s: %s cannot be read", caller, file);
+    if (n > FV_MAX_BYTES)
+        return refuse_file("%s: %s is larger than %d bytes: no file of fixed values is", caller, file,
+                           FV_MAX_BYTES);
+    if (memchr(text, '\0', n))
+        return refuse_file("%s: %s holds a NUL byte: it is no text", caller, file);
+    text[n] = '\0';
+    return 1;
+}
+
+/* The values of the file's text set; in->fixed keeps those a reset sets again. */
+static int take_file(fmu_instance *in, reading *r, char *text, const char *file, const char *caller)
+{
+    const size_t count = fm_variables()->count;
+    fv_values *shrunk;
+    int ok;
+    in->fixed = malloc(sizeof *in->fixed + count * sizeof in->fixed->list[0]);
+    r->lines = calloc(count, sizeof *r->lines);
+    if (!in->fixed || !r->lines) {
+        free(r->lines);
+        return refuse("%s: out of memory", caller);
+    }
+    in->fixed->context = NULL;
+    in->fixed->sink = in->sink;
+    in->fixed->count = 0;
+    in->sink = in_context;
+    ok = take_lines(in, r, text, file, caller);
+    in->sink = in->fixed->sink;
+    free(r->lines);
+    shrunk = realloc(in->fixed, sizeof *in->fixed + in->fixed->count * sizeof in->fixed->list[0]);
+    in->fixed = shrunk ? shrunk : in->fixed;
+    return ok;
+}
+
+int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller, const char *token,
+            const char *what)
+{
+    char file[MAX_PATH_BYTES + 32], text[FV_MAX_BYTES + 1];
+    reading r = {NULL, "", 0};
+    int found = file_path(resources, uri, file, sizeof file) ? read_text(in, file, text, caller) : 0;
+    if (found < 0 || (found && !take_file(in, &r, text, file, caller)))
+        return 0;
+    return token_accepted(in, token, r.token, what);
 }
 
 void fv_reset(fmu_instance *in)

@@ -14,15 +14,13 @@
 
 /* Sets the values of the file in `resources` (FMI 2.0's file URI of the
  * resources folder where `uri`, else FMI 3.0's path, ending in a separator;
- * NULL: none). 0 after an error naming `caller`, the file, its line, the
- * variable, the value and the rule; the values are then half set and the
- * instance is to be released. */
-int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller);
-
-/* Whether `token` (the importer's GUID or instantiation token, named
- * `what` in the error) is the FMU's: the file's "guid" line, which an
- * exported modelDescription.xml carries, or the full FMU's (guid.h). */
-int fv_accepts(const fmu_instance *in, const char *token, const char *what);
+ * NULL: none), and checks the importer's `token` (its GUID or instantiation
+ * token, named `what` in an error) against the file's "guid" line, which an
+ * exported modelDescription.xml carries, or the full FMU's (guid.h). 0 after
+ * an error naming `caller`, the file, its line, the variable, the value and
+ * the rule; the values are then half set and the instance is to be released. */
+int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller, const char *token,
+            const char *what);
 
 /* fm_reset, then the fixed values again: the instance as instantiated. */
 void fv_reset(fmu_instance *in);

@@ -102,8 +102,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         free(in);
         return NULL;
     }
-    if (!fv_load(&in->base, fmuResourceLocation, 1, "fmi2Instantiate")
-        || !fv_accepts(&in->base, fmuGUID, "fmi2Instantiate: fmuGUID")) {
+    if (!fv_load(&in->base, fmuResourceLocation, 1, "fmi2Instantiate", fmuGUID, "fmi2Instantiate: fmuGUID")) {
         fi_release(&in->base);
         free(in);
         return NULL;

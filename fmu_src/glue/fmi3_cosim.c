@@ -104,8 +104,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         free(in);
         return NULL;
     }
-    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation")
-        || !fv_accepts(&in->base, instantiationToken, "fmi3InstantiateCoSimulation: instantiationToken")) {
+    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation", instantiationToken, "fmi3InstantiateCoSimulation: instantiationToken")) {
         fi_release(&in->base);
         free(in);
         return NULL;
