@@ -204,7 +204,7 @@ def build_parser(prog=None):
                              "against alpha")
     parser.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
     parser.add_argument("--export-fmu", type=fmu_file, metavar="FILE",
-                        help="also write the calibrated contact as an FMU (fraccontact export's drop scene: one "
+                        help="also write the calibrated contact as an FMU [.fmu] (fraccontact export's drop scene: one "
                              "body, Gauss-Seidel, FMI 2.0; docs/export.md)")
     parser.add_argument("--material", help="with --export-fmu: the material, for the FMU's description")
     return parser
