@@ -5,6 +5,7 @@ with the FMU, its reference result, its inputs, the options of the run and a
 ReadMe, which fmpy's validator of vendor repositories checks."""
 
 import pathlib
+import re
 import zipfile
 
 import numpy as np
@@ -20,9 +21,9 @@ def package_version():
     import importlib.metadata
     try:
         return importlib.metadata.version("fraccontact")
-    except importlib.metadata.PackageNotFoundError:
-        import tomllib
-        return tomllib.loads((pathlib.Path(__file__).parents[2] / "pyproject.toml").read_text())["project"]["version"]
+    except importlib.metadata.PackageNotFoundError:  # tomllib is Python 3.11's; the package runs on 3.9
+        text = (pathlib.Path(__file__).parents[2] / "pyproject.toml").read_text()
+        return re.search(r'^version = "([^"]+)"', text, re.M).group(1)
 
 
 def csv_text(names, columns):
