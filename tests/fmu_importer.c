@@ -6,8 +6,10 @@
  * binaries through their exported functions alone, as a user's tool sees them.
  * REPEATS runs the experiment that many times, each in a new instance, and
  * prints the last one's results (tests/instruction_counts.py counts a run's
- * instructions as the difference of two such counts).
- *   fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS]  */
+ * instructions as the difference of two such counts). RESOURCES and GUID
+ * instantiate an exported FMU: its resources folder's file: URI and its GUID
+ * (tests/windows_fmu.py same-exported-results).
+ *   fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS [RESOURCES GUID]]  */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,13 +82,14 @@ static void ok(fmi2Status status, const char *call)
 /* The default experiment in a new instance: the outputs at its end, the
  * impulse of F_avg, and the first and the last communication point in
  * contact (-1: none). */
-static void experiment(const char *binary, double end[OUTPUTS], double *impulse, double *t_first, double *t_last)
+static void experiment(const char *binary, const char *resources, const char *guid, double end[OUTPUTS],
+                       double *impulse, double *t_first, double *t_last)
 {
     const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     const fmi2ValueReference vr_F_avg = VR_F_avg, vr_contact = VR_contact;
     const fmi2ValueReference vr_end[OUTPUTS] = {VR_F_peak, VR_eps, VR_E_diss, VR_x2, VR_v_striker};
     long i, steps = (long)(STOP / H + 0.5);
-    fmi2Component c = LOAD(fmi2Instantiate)("importer", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False,
+    fmi2Component c = LOAD(fmi2Instantiate)("importer", fmi2CoSimulation, guid, resources, &callbacks, fmi2False,
                                             fmi2False);
     if (!c) {
         fprintf(stderr, "fmu_importer: fmi2Instantiate failed\n");
@@ -119,15 +122,17 @@ int main(int argc, char **argv)
 {
     const char *names[OUTPUTS] = {"F_peak", "eps", "E_diss", "x2", "v_striker"};
     double end[OUTPUTS], impulse, t_first, t_last;
-    long repeats = argc == 3 ? atol(argv[2]) : 1, r;
+    long repeats = argc >= 3 ? atol(argv[2]) : 1, r;
+    const char *resources = argc == 5 ? argv[3] : "", *guid = argc == 5 ? argv[4] : FMU_GUID;
     size_t k;
 
-    if ((argc != 2 && argc != 3) || repeats < 1) {
-        fprintf(stderr, "usage: fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS]\n");
+    if ((argc != 2 && argc != 3 && argc != 5) || repeats < 1) {
+        fprintf(stderr, "usage: fmu_importer path/to/binaries/<platform>/fraccontact.{so,dll} [REPEATS [RESOURCES "
+                        "GUID]]\n");
         return 2;
     }
     for (r = 0; r < repeats; r++)
-        experiment(argv[1], end, &impulse, &t_first, &t_last);
+        experiment(argv[1], resources, guid, end, &impulse, &t_first, &t_last);
     for (k = 0; k < OUTPUTS; k++)
         printf("%s %.17g\n", names[k], end[k]);
     printf("impulse %.17g\nt_contact_first %.17g\nt_contact_last %.17g\n", impulse, t_first, t_last);

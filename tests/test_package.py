@@ -197,6 +197,7 @@ def installed_files():
     listed = re.search(r"install\(FILES (.*?) DESTINATION fraccontact\)", cmake, re.S).group(1)
     names = set(re.findall(r"/([\w.]+\.(?:fmu|ssp))\"", listed))
     variables = {"${FMU_FILE}": re.search(r'set\(FMU_FILE "\$\{CMAKE_BINARY_DIR\}/([\w.]+)"\)', cmake).group(1),
+                 "${FMU3_FILE}": re.search(r'set\(FMU3_FILE "\$\{CMAKE_BINARY_DIR\}/([\w.-]+)"\)', cmake).group(1),
                  "${SSP_FILE}": re.search(r'set\(SSP_FILE "\$\{CMAKE_BINARY_DIR\}/([\w.]+)"',
                                           (ROOT / "ssp" / "CMakeLists.txt").read_text()).group(1)}
     names |= {name for variable, name in variables.items() if variable in listed}
@@ -207,7 +208,8 @@ def installed_files():
 
 def test_the_package_page_names_every_file_the_package_ships():
     shipped = installed_files()
-    assert {"fraccontact.fmu", "striker.fmu", "body.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"} <= shipped
+    assert {"fraccontact.fmu", "fraccontact-fmi3.fmu", "striker.fmu", "body.fmu", "drop_test.ssp", "headform.ssp",
+            "bumper.ssp"} <= shipped
     prose = " ".join(section("In Python: the `fraccontact` package").split())
     assert [name for name in sorted(shipped) if f"`{name}`" not in prose] == []
 

@@ -4,6 +4,9 @@
   windows_fmu.py tables X.fmu...           each DLL's import and export tables
   windows_fmu.py same-results X.fmu IMPORTER IMPORTER.exe
                                            the drop test on the Linux and the Windows binary
+  windows_fmu.py same-exported-results IMPORTER IMPORTER.exe
+                                           the same for an exported FMU (fraccontact export, its fixed
+                                           values read from its resources through a file: URI each)
   windows_fmu.py stop                      end the Wine server, so that ctest does not wait for it
 
 Wine runs in the environment ctest gives (WINEPREFIX inside the build folder)."""
@@ -101,6 +104,29 @@ def prefix():
     return 0
 
 
+def exported_results(importer, importer_exe):
+    """An FMU exported with values other than the defaults (python -m fraccontact export, on
+    $FRACCONTACT_FMU): its Linux and Windows binaries give the same results, the full FMU's Linux binary
+    others (the file is read, on Windows from a file:///Z:/ URI, Wine's drive of /)."""
+    import pathlib
+    with tempfile.TemporaryDirectory() as folder:
+        fmu = os.path.join(folder, "exported.fmu")
+        subprocess.run([sys.executable, "-m", "fraccontact", "export", fmu, "--c", "5000", "--k", "3e8"],
+                       check=True, capture_output=True)
+        with zipfile.ZipFile(fmu) as z:
+            guid = re.search(r'guid="([^"]+)"', z.read("modelDescription.xml").decode()).group(1)
+        unpacked = os.path.join(folder, "unpacked")
+        so, dll = binaries(fmu, unpacked)
+        resources = pathlib.Path(unpacked, "resources")
+        linux = results([importer, so, "1", resources.as_uri(), guid])
+        windows = results([need("wine", "wine and wine64"), importer_exe, dll, "1",
+                           "file:///Z:" + resources.as_posix(), guid])
+        full = results([importer, so])
+    for name in linux:
+        print(f"{name:16} Linux {linux[name]!r:24} Windows {windows[name]!r:24} full {full[name]!r}")
+    return linux != windows or linux["F_peak"] == full["F_peak"]
+
+
 def results(command):
     done = subprocess.run(command, capture_output=True, text=True, timeout=120)
     if done.returncode != 0:
@@ -136,6 +162,8 @@ def main(argv):
         return tables(argv[1:])
     if argv[:1] == ["same-results"] and len(argv) == 4:
         return same_results(*argv[1:])
+    if argv[:1] == ["same-exported-results"] and len(argv) == 3:
+        return exported_results(*argv[1:])
     if argv[:1] == ["stop"]:
         subprocess.run([need("wineserver", "wine"), "-k"])  # fails when no server runs: fine
         return 0

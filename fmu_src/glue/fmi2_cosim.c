@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fixed_values.h"
 #include "fmu_instance.h"
 #include "fmu_vars.h"
 #include "guid.h"
@@ -74,7 +75,6 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               fmi2Boolean visible, fmi2Boolean loggingOn)
 {
     instance probe, *in;
-    (void)fmuResourceLocation;
     (void)visible;
     if (!functions)
         return NULL;
@@ -88,7 +88,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         fail(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
         return NULL;
     }
-    if (!fmuGUID || strcmp(fmuGUID, FMU_GUID) != 0) {
+    if (!fmuGUID) {
         fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FMU_GUID ")");
         return NULL;
     }
@@ -99,6 +99,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     }
     in->callbacks = *functions;
     if (!fi_init(&in->base, instanceName, send_log, loggingOn != fmi2False, INSTANTIATED)) {
+        free(in);
+        return NULL;
+    }
+    if (!fv_load(&in->base, fmuResourceLocation, 1, "fmi2Instantiate", fmuGUID, "fmi2Instantiate: fmuGUID")) {
+        fi_release(&in->base);
         free(in);
         return NULL;
     }
@@ -176,7 +181,7 @@ fmi2Status fmi2Reset(fmi2Component c)
 {
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi2Reset");
-    fm_reset(in->base.fm);
+    fv_reset(&in->base);
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
+#include "fixed_values.h"
 #include "fmu_instance.h"
 #include "fmu_vars.h"
 #include "guid.h"
@@ -71,7 +72,6 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     instance probe, *in;
-    (void)resourcePath;
     (void)visible;
     (void)requiredIntermediateVariables;
     probe.environment = instanceEnvironment;
@@ -81,7 +81,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         fail(&probe, "fmi3InstantiateCoSimulation: instanceName must be a non-empty string");
         return NULL;
     }
-    if (!instantiationToken || strcmp(instantiationToken, FMU_GUID) != 0) {
+    if (!instantiationToken) {
         fail(&probe, "fmi3InstantiateCoSimulation: instantiationToken does not match modelDescription.xml (" FMU_GUID
                      ")");
         return NULL;
@@ -101,6 +101,11 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     in->event_mode_used = eventModeUsed;
     in->early_return_allowed = earlyReturnAllowed;
     if (!fi_init(&in->base, instanceName, send_log, loggingOn, INSTANTIATED)) {
+        free(in);
+        return NULL;
+    }
+    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation", instantiationToken, "fmi3InstantiateCoSimulation: instantiationToken")) {
+        fi_release(&in->base);
         free(in);
         return NULL;
     }
@@ -250,7 +255,7 @@ fmi3Status fmi3Reset(fmi3Instance c)
 {
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi3Reset");
-    fm_reset(in->base.fm);
+    fv_reset(&in->base);
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;

@@ -63,6 +63,11 @@ void fm_reset(fmu_model *fm)
     start_values(fm);
 }
 
+const fmu_variables *fm_variables(void)
+{
+    return &variables;
+}
+
 /* The value stored for the variable `vr` of that type, set or read. */
 static fm_status set_stored(fmu_model *fm, unsigned vr, var_type type, const void *value, size_t size)
 {

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fixed_values.h"
 #include "guid.h"
 #include "serial.h"
 
@@ -73,6 +74,7 @@ int fi_init(fmu_instance *in, const char *name, fi_sink sink, int logging_on, in
 
 void fi_release(fmu_instance *in)
 {
+    fv_free(in);
     fm_free(in->fm);
     free(in->name);
 }

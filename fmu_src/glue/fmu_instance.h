@@ -15,6 +15,7 @@ typedef enum { FI_OK = 0, FI_WARNING = 1, FI_DISCARD = 2, FI_ERROR = 3 } fi_stat
 #define FI_CATEGORIES 4 /* logEvents, logCalls, logStatusWarning, logStatusError */
 
 typedef struct fmu_instance fmu_instance;
+typedef struct fv_values fv_values; /* fixed_values.c's */
 
 /* How a version hands a message to the master's logger. */
 typedef void (*fi_sink)(const fmu_instance *in, fi_status status, const char *category, const char *message);
@@ -24,11 +25,12 @@ struct fmu_instance {
     char *name;
     int state; /* one bit of the version's state machine */
     int logging_on;
-    int category_on[FI_CATEGORIES];
+    unsigned char category_on[FI_CATEGORIES];
     double start_time;
     double stop_time; /* the experiment's, INFINITY when the master gives none */
     fmu_model *fm;
     fi_sink sink;
+    fv_values *fixed; /* an exported FMU's fixed values (fixed_values.h), NULL in the full FMU */
 };
 
 /* A probe: an instance that can only log (before one exists). */

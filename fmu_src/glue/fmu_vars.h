@@ -40,6 +40,9 @@ fm_status fmu_say(const fmu_reporter *r, fm_status status, const char *category,
  * fmi3_cosim.c). */
 extern const char *const fmu_type_names[3];
 
+/* The model's table, `variables` (defined by fmu_defaults.h). */
+const fmu_variables *fm_variables(void);
+
 /* The variable of that reference and type, or NULL after an error report
  * naming the variable that reference has, if any, and its type. */
 const fmu_variable *fmu_find(const fmu_variables *vars, unsigned vr, var_type type, const fmu_reporter *r);

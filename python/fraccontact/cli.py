@@ -14,11 +14,13 @@ COMMANDS = {
     "sweep": "parameter sweeps and Monte Carlo campaigns on Dask, a library call per task",
     "cosim": "the drop test as two FMUs (striker + contact) coupled through fmpy or libcosim",
     "scene": "a crash scene (headform, bumper) as its SSP in fmpy, libcosim, a container FMU, or its reference",
+    "export": "the contact of one scene as its own FMU: only what the scene sets or reads, the rest fixed",
 }
 MODULES = {"run": "fraccontact.run", "fit": "fraccontact.fit", "sweep": "fraccontact.sweep",
-           "cosim": "fraccontact.cosim", "scene": "fraccontact.scenes.cli"}
+           "cosim": "fraccontact.cosim", "scene": "fraccontact.scenes.cli",
+           "export": "fraccontact.export"}
 # The extra of pyproject.toml's optional-dependencies that installs what each command imports.
-EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "scene": "cosim"}
+EXTRAS = {"run": "run", "fit": "fit", "sweep": "sweep", "cosim": "cosim", "scene": "cosim", "export": "cosim"}
 
 
 def parser():

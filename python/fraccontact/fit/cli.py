@@ -138,6 +138,31 @@ def plot_file(text):
     return path
 
 
+def fmu_file(text):
+    """argparse type: a path in an existing folder, checked now so that a long fit does not end in a failed
+    export."""
+    path = pathlib.Path(text)
+    if not path.parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: the folder {path.parent} does not exist")
+    return path
+
+
+def data_source(args):
+    """What the fit was fitted to, for an exported FMU's description."""
+    if args.curve:
+        return ", ".join(str(p) for p in args.curve)
+    if args.drops is not None:
+        return str(args.drops)
+    return f"F_peak = {args.F_peak:g} N, eps = {args.eps:g}"
+
+
+def exported_fmu(args, result):
+    """--export-fmu: the fit's contact as an FMU; a line saying so."""
+    from ..export import export
+    out = export(args.export_fmu, fit=result, source=data_source(args), material=args.material)
+    return f"{out['path']}: {len(out['variables'])} of the full FMU's {out['full_variables']} variables"
+
+
 def default_help(name, what):
     """'what [unit] (default ...)' of a parameter, from the library's table."""
     p = next(p for p in model.parameters() if p["name"] == name)
@@ -178,6 +203,10 @@ def build_parser(prog=None):
                              "F_max and eps against height, for a family (--damper 2, one test) k, c_alpha, E_s "
                              "against alpha")
     parser.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead of text")
+    parser.add_argument("--export-fmu", type=fmu_file, metavar="FILE",
+                        help="also write the calibrated contact as an FMU [.fmu] (fraccontact export's drop scene: one "
+                             "body, Gauss-Seidel, FMI 2.0; docs/export.md)")
+    parser.add_argument("--material", help="with --export-fmu: the material, for the FMU's description")
     return parser
 
 
@@ -201,6 +230,8 @@ def check_arguments(parser, args):
         parser.error("--damper-order needs --damper 2 (the springpot)")
     if args.plot is not None and args.F_peak is not None and not (args.damper == 2 and args.damper_order is None):
         parser.error("--plot needs --curve or --drops, or --damper 2 with --F-peak (the family)")
+    if args.material is not None and args.export_fmu is None:
+        parser.error("--material goes with --export-fmu")
 
 
 def add_specimen_modulus(result, args):
@@ -314,6 +345,13 @@ def main(argv=None, prog=None):
             mb.pop("x", None)
     for w in warnings:
         print(f"{parser.prog}: warning: {w}", file=sys.stderr)
+    if args.export_fmu is not None:
+        try:
+            written = exported_fmu(args, result)
+        except ValueError as e:
+            print(f"{parser.prog}: --export-fmu {args.export_fmu}: {e}", file=sys.stderr)
+            return 2
+        print(f"{parser.prog}: wrote {written}", file=sys.stderr)
     if args.json:
         print(json.dumps(result))
     else:

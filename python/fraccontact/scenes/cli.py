@@ -3,11 +3,13 @@ a master, or its monolithic reference; prints its crash figures as JSON.
 
   fraccontact scene headform --master fmpy --H 1e-5 --headform child --gap0 0.05
   fraccontact scene bumper --master libcosim --v 1.1111
+  fraccontact scene headform --ssp headform_exported.ssp    (its contacts exported FMUs, docs/export.md)
 """
 
 import argparse
 import json
 import math
+import pathlib
 import sys
 import zipfile
 
@@ -55,6 +57,9 @@ def parser(prog=None):
     p.add_argument("--zeta-box", type=non_negative, help="bumper: the crash box's damping ratio")
     p.add_argument("--M", type=positive, help="bumper: the vehicle body's mass [kg]")
     p.add_argument("--m-b", type=positive, help="bumper: the beam's mass [kg]")
+    p.add_argument("--ssp", type=pathlib.Path, metavar="FILE",
+                   help="another SSP of the scene (default the build's or the package's), such as one of exported "
+                        "contacts (fraccontact export --ssp, docs/export.md): the values it fixes must be the scene's")
     return p
 
 
@@ -67,12 +72,14 @@ def options_of(p, args):
     return {name: getattr(args, name) for name in own if getattr(args, name) is not None}
 
 
-def check_ssp(p, scene):
-    """The scene's SSP is there and a zip archive, or a usage error."""
+def check_ssp(p, scene, path):
+    """The scene's SSP (path, or ssp_path(scene) where None) is there and a zip archive, or a usage error."""
     try:
-        path = ssp_path(scene)
+        path = ssp_path(scene) if path is None else path
     except FileNotFoundError as e:
         p.error(str(e))
+    if not path.is_file():
+        p.error(f"--ssp {path}: no such file")
     if not zipfile.is_zipfile(path):
         p.error(f"{path} is not an SSP (a zip archive): rebuild it (scripts/build)")
 
@@ -93,9 +100,11 @@ def main(argv=None, prog=None):
                 "(the deceleration's CFC filter takes 3 samples)")
     options = options_of(p, args)
     if args.master != "reference":
-        check_ssp(p, args.name)
+        check_ssp(p, args.name, args.ssp)
+    elif args.ssp is not None:
+        p.error("--ssp goes with a master, not with --master reference")
     try:
-        trace = run(args.name, args.master, H, t_end, options)
+        trace = run(args.name, args.master, H, t_end, options, ssp=args.ssp)
         result = figures(trace, args.name, options)
     except (ValueError, RuntimeError, OSError) as e:
         p.error(str(e).splitlines()[0])

@@ -25,10 +25,12 @@ Masters (each but container-gs steps every FMU from the last communication point
   reference  the scene's Chain (scenes.chain) solved monolithically by scipy.
 """
 
+import pathlib
+
 import numpy as np
 
 from .. import crash, fmu_path
-from ..ssp import bound_parameters, grid
+from ..ssp import bound_parameters, exposed_values, grid
 from . import bumper as bumper_reference
 from . import headform as headform_reference
 from .chain import Contact
@@ -70,20 +72,21 @@ def values(scene, options=None):
     return VALUES[scene](**scene_arguments(scene, options))
 
 
-def run(scene, master, H=None, t_end=None, options=None):
-    """A trace of the scene in master at step H [s] until t_end [s]."""
+def run(scene, master, H=None, t_end=None, options=None, ssp=None):
+    """A trace of the scene in master at step H [s] until t_end [s]; ssp: the path of another SSP of the
+    scene (its contacts exported FMUs, docs/export.md) instead of ssp_path(scene)."""
     H = STEP[scene] if H is None else H
     t_end = T_END[scene] if t_end is None else t_end
     if master == "reference":
         return reference(scene, H, t_end, options)
     runner = {"fmpy": run_fmpy, "libcosim": run_libcosim, "container": run_container,
               "container-gs": run_container_gs, "omsimulator": run_omsimulator}[master]
-    return runner(scene, H, t_end, values(scene, options))
+    path = ssp_path(scene) if ssp is None else pathlib.Path(ssp)
+    return runner(scene, H, t_end, exposed_values(path, values(scene, options)), path)
 
 
-def run_fmpy(scene, H, t_end, start):
+def run_fmpy(scene, H, t_end, start, path):
     from fmpy.ssp.simulation import simulate_ssp
-    path = ssp_path(scene)
     parameters = bound_parameters(path)
     overridden = {f"{c}.{name}" for c, vs in start.items() for name in vs}
     parameters.parameters = [p for p in parameters.parameters if p.name not in overridden]
@@ -102,12 +105,12 @@ def run_fmpy(scene, H, t_end, start):
     return dict(trace, t=t[:len(rows)])
 
 
-def run_libcosim(scene, H, t_end, start):
+def run_libcosim(scene, H, t_end, start, path):
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
     log_output_level(CosimLogLevel.ERROR)
-    ex = CosimExecution.from_ssp_file(str(ssp_path(scene)), step_size=round(H * 1e9))  # libcosim counts ns
+    ex = CosimExecution.from_ssp_file(str(path), step_size=round(H * 1e9))  # libcosim counts ns
     index = {}
     refs = {}
     for component, vs in start.items():
@@ -152,20 +155,20 @@ def initial(name, start):
     return float(values.get("v0", 0.0)) if moves else 0.0
 
 
-def run_container(scene, H, t_end, start, sequential=False):
+def run_container(scene, H, t_end, start, path, sequential=False):
     from .container import simulate
     t = grid(H, t_end)
-    series = simulate(ssp_path(scene), H, t[-1], start, RECORDED[scene], sequential)
+    series = simulate(path, H, t[-1], start, RECORDED[scene], sequential)
     return dict(series, t=t[:len(series[RECORDED[scene][0]])])
 
 
-def run_container_gs(scene, H, t_end, start):
-    return run_container(scene, H, t_end, start, sequential=True)
+def run_container_gs(scene, H, t_end, start, path):
+    return run_container(scene, H, t_end, start, path, sequential=True)
 
 
-def run_omsimulator(scene, H, t_end, start):
+def run_omsimulator(scene, H, t_end, start, path):
     from ..omsimulator import simulate
-    return simulate(ssp_path(scene), H, grid(H, t_end), start, RECORDED[scene])
+    return simulate(path, H, grid(H, t_end), start, RECORDED[scene])
 
 
 def reference(scene, H, t_end, options=None):
