@@ -21,7 +21,8 @@ from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
 import fraccontact
-from fraccontact.export import COUPLINGS, FIXED_VALUES
+from fraccontact.export import COUPLINGS
+from fraccontact.fixed_values import FIXED_VALUES
 from doc_pages import fenced_blocks
 from fmu_driver import Slave
 

@@ -19,7 +19,7 @@ import fraccontact
 from closed_forms import HERTZ_TC, SCHEME_RTOL, hertz_k
 from doc_pages import section, text
 from fmu_driver import C, K, M, V0
-from fraccontact import cli, crash, ssp
+from fraccontact import cli, crash, shipped, ssp
 from fraccontact.scenes import bumper, headform, masters
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -181,7 +181,7 @@ def test_the_scene_is_found_beside_the_installed_fmus(monkeypatch, tmp_path):
     """An installed package: no environment variables, the FMUs and the scene in the package's folder."""
     for name in ("fraccontact.fmu", "drop_test.ssp", "headform.ssp", "bumper.ssp"):
         (tmp_path / name).write_bytes(b"")
-    monkeypatch.setattr(fraccontact, "_HERE", tmp_path)
+    monkeypatch.setattr(shipped, "_HERE", tmp_path)
     for variable in ("FRACCONTACT_FMU", "DROP_TEST_SSP"):
         monkeypatch.delenv(variable, raising=False)
     assert ssp.ssp_path() == tmp_path / "drop_test.ssp"

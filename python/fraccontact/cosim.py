@@ -39,7 +39,8 @@ import sys
 from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
 
-from . import fmu_path, model
+from . import model
+from .shipped import fmu_path
 from .fmu import Slave, description, unpacked
 from .options import OneLineParser, finite, positive
 from .scipy_contact import solve_drop

@@ -33,11 +33,12 @@ import warnings
 import xml.etree.ElementTree as ET
 import zipfile
 
-from . import fmu_path, model
+from . import model
 from .atomic import replacing
+from .fixed_values import FIXED_VALUES
 from .options import OneLineParser
+from .shipped import fmu_path
 
-FIXED_VALUES = "resources/fixed_values.txt"  # fmu_src/glue/fixed_values.h's file
 FMU_FILES = {2: "fraccontact", 3: "fraccontact-fmi3"}
 SCENES = model.WORDS["scene"]  # drop, driven
 COUPLINGS = {"gauss-seidel": 1, "jacobi": 2}  # the coupling parameter's codes
@@ -314,17 +315,6 @@ def fmu_bytes(source, description, fixed_text):
         z.writestr("modelDescription.xml", description)
         z.writestr(FIXED_VALUES, fixed_text)
     return out.getvalue()
-
-
-def fixed_of(fmu):
-    """{name: value text} of an exported FMU's fixed values, and the names its modelDescription.xml has."""
-    with zipfile.ZipFile(fmu) as z:
-        if FIXED_VALUES not in z.namelist():
-            raise ValueError(f"{fmu} is no exported FMU: it has no {FIXED_VALUES} (fraccontact export writes one)")
-        lines = z.read(FIXED_VALUES).decode().splitlines()
-        names = {e.get("name") for e in ET.fromstring(z.read("modelDescription.xml")).find("ModelVariables")}
-    words = (line.partition("#")[0].split() for line in lines)
-    return {w[0]: w[1] for w in words if len(w) == 2}, names
 
 
 def instantiation_error(data, fmi):

@@ -19,10 +19,10 @@ import zipfile
 
 import numpy as np
 
-from . import fmu_path
+from .shipped import fmu_path
 from .atomic import replacing
 from .cosim import M, V0
-from .export import FIXED_VALUES, fixed_of
+from .fixed_values import FIXED_VALUES, fixed_of
 
 T_END = 3e-3  # the SSD's DefaultExperiment: the impact and the rebound
 
