@@ -21,7 +21,12 @@ FMI2, FMI3, PAGE = pathlib.Path("modelDescription.xml"), pathlib.Path("fmi3/mode
     pathlib.Path("docs/variables.md")
 COLUMNS = ("name", "type", "unit", "default", "min", "max", "vr", "index", "variability", "words", "rule",
            "description")
-KINDS = ("input", "parameter", "stop", "option", "output")
+KINDS = ("input", "parameter", "stop", "option", "output", "derivative", "state")
+# Model Exchange's kinds: der(name) of an output, and a local state of MODES elements.
+EXCHANGE_KINDS = ("derivative", "state")
+MODES = int(re.search(r"#define CONTACT_MAX_MODES (\d+)", pathlib.Path(__file__).parent.joinpath(
+    "..", "model", "contact.h").read_text()).group(1))
+DERIVATIVE_OFFSET = 1000  # a STATE row's der(name[i]) is this many value references on (fmu_model.h)
 PLACES = ("model", "fmu", "library", "solver", "package")
 # The initial unknowns that depend on a variable at the start: x = -gap0, v_striker = v - v2.
 INITIAL_DEPENDENCIES = {"x": ("gap0",), "v_striker": ("v", "v2")}
@@ -60,8 +65,52 @@ def read_table(path):
 
 
 def fmu_rows(rows):
-    """The FMU's variables in the order of modelDescription.xml."""
-    return sorted((r for r in rows if "fmu" in r["where"]), key=lambda r: int(r["index"]))
+    """The FMU's variables in the order of modelDescription.xml, but Model Exchange's."""
+    return sorted((r for r in rows if "fmu" in r["where"] and r["kind"] not in EXCHANGE_KINDS),
+                  key=lambda r: int(r["index"]))
+
+
+def exchange_variables(rows):
+    """Model Exchange's variables as dicts (name, vr, index, unit, description, start, and
+    derivative: the name of the state whose derivative it is, or None), in index order: a
+    DERIVATIVE row's der(name), a STATE row's name[1..MODES] and then der(name[i])."""
+    found = []
+    for r in rows:
+        if r["kind"] == "derivative":
+            found.append(dict(name=f"der({r['name']})", vr=r["vr"], index=r["index"], unit=r["unit"],
+                              description=r["description"], start="", derivative=r["name"]))
+        elif r["kind"] == "state":
+            for i in range(MODES):
+                found.append(dict(name=f"{r['name']}[{i + 1}]", vr=str(int(r["vr"]) + i),
+                                  index=str(int(r["index"]) + i), unit=r["unit"], start=r["default"],
+                                  description=r["description"] if i == 0 else
+                                  f"mode {i + 1} of {r['name']} (see {r['name']}[1])", derivative=None))
+            for i in range(MODES):
+                found.append(dict(name=f"der({r['name']}[{i + 1}])", vr=str(int(r["vr"]) + DERIVATIVE_OFFSET + i),
+                                  index=str(int(r["index"]) + MODES + i), unit=f"{r['unit']}/s",
+                                  description=f"the rate of {r['name']}[{i + 1}]", start="",
+                                  derivative=f"{r['name']}[{i + 1}]"))
+    return sorted(found, key=lambda v: int(v["index"]))
+
+
+def state_index(variables, fmu, name):
+    """The FMI 2.0 index of the state `name`: an output's, or a STATE row's element."""
+    by_name = {r["name"]: r["index"] for r in fmu}
+    by_name.update({v["name"]: v["index"] for v in variables})
+    return by_name[name]
+
+
+def fmi2_exchange_variable(v, fmu, variables):
+    if v["derivative"]:
+        real = f'<Real unit="{v["unit"]}" derivative="{state_index(variables, fmu, v["derivative"])}"/>'
+        initial = ""
+    else:
+        real = f'<Real unit="{v["unit"]}" start="{v["start"]}"/>'
+        initial = ' initial="exact"'
+    return (f'    <!-- {v["index"]} --><ScalarVariable name="{v["name"]}" valueReference="{v["vr"]}" '
+            f'causality="local" variability="continuous"{initial}\n'
+            f'      description="{html.escape(v["description"], quote=False)}">\n'
+            f'      {real}</ScalarVariable>')
 
 
 def attributes(row, names):
@@ -95,13 +144,21 @@ def fmi2_section(rows):
     fmu = fmu_rows(rows)
     by_name = {r["name"]: r for r in fmu}
     outputs = [r for r in fmu if r["kind"] == "output"]
-    lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu] + ["  </ModelVariables>", "",
-                                                                           "  <ModelStructure>", "    <Outputs>",
-             "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
+    exchange = exchange_variables(rows)
+    derivatives = [v for v in exchange if v["derivative"]]
+    lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu]
+    lines += [fmi2_exchange_variable(v, fmu, exchange) for v in exchange]
+    lines += ["  </ModelVariables>", "", "  <ModelStructure>", "    <Outputs>",
+              "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies=""/>' for r in outputs]
-    lines += ["    </Outputs>", "    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
+    lines += ["    </Outputs>"]
+    if derivatives:
+        lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
+        lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives] + ["    </Derivatives>"]
+    lines += ["    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies="{dependencies(r, by_name, "index")}"/>'
               for r in outputs]
+    lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives]
     return "\n".join(lines + ["    </InitialUnknowns>", "  </ModelStructure>"])
 
 

@@ -1,5 +1,6 @@
 #include "fmu_model.h"
 
+#include "fmu_me.h"
 #include "fmu_vars.h"
 #include "serial.h"
 
@@ -62,6 +63,7 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
+    double me_speed, me_mass; /* Model Exchange: the approach speed and mass its nominal values are of */
     contact_model model;
     prediction next;
     fmu_reporter log;
@@ -258,9 +260,14 @@ static const fmu_variable *nonfinite_output(const fmu_model *fm)
     return NULL;
 }
 
+static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value);
+
 fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
 {
-    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
+    const fmu_variable *var;
+    if (model_exchange_variable(fm, vr, value))
+        return FM_OK;
+    var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
     if (!var)
         return FM_ERROR;
     preview_start(fm);
@@ -699,6 +706,117 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
                       fm->coupling == COUPLING_JACOBI ? COUPLING_GAUSS_SEIDEL : COUPLING_JACOBI);
     }
     return FM_OK;
+}
+
+/* ------------------------------------------------------- Model Exchange */
+
+const size_t fm_me_states = CONTACT_ME_STATES, fm_me_indicators = CONTACT_ME_INDICATORS;
+
+/* The driven scene's indentation rate is its input, read wherever the
+ * model's rates are. */
+static void me_follow_inputs(fmu_model *fm)
+{
+    preview_start(fm); /* before initialization ends: the state it would start from */
+    if (fm->params.scene == CONTACT_SCENE_DRIVEN)
+        fm->model.s.v = approach(&fm->in);
+}
+
+fm_status fm_me_start(fmu_model *fm, double t0, double t_stop)
+{
+    char why[512];
+    fm_status status;
+    if (contact_me_check(&fm->params, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    status = fm_start(fm, t0, t_stop);
+    if (status == FM_ERROR)
+        return status;
+    /* the host's solver moves the bodies: no proxy striker in the driven scene */
+    if (fm->params.scene == CONTACT_SCENE_DRIVEN)
+        contact_drive(&fm->model, approach(&fm->in), 0.0, 0.0);
+    fm->me_speed = approach(&fm->in);
+    fm->me_mass = fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0;
+    return status;
+}
+
+void fm_me_set_time(fmu_model *fm, double t)
+{
+    fm->model.s.t = t;
+}
+
+fm_status fm_me_set_states(fmu_model *fm, const double *x)
+{
+    size_t i;
+    for (i = 0; i < CONTACT_ME_STATES; i++)
+        if (!isfinite(x[i]))
+            return report(fm, FM_ERROR, "logStatusError", "SetContinuousStates: the state %lu is %g: it must be finite",
+                          (unsigned long)i, x[i]);
+    contact_me_set_states(&fm->model, x);
+    me_follow_inputs(fm);
+    return FM_OK;
+}
+
+void fm_me_get_states(fmu_model *fm, double *x)
+{
+    me_follow_inputs(fm);
+    contact_me_get_states(&fm->model, x);
+}
+
+fm_status fm_me_derivatives(fmu_model *fm, double *dx)
+{
+    me_follow_inputs(fm);
+    contact_me_derivatives(&fm->model, dx);
+    return FM_OK;
+}
+
+void fm_me_nominals(fmu_model *fm, double *nominal)
+{
+    contact_me_nominals(&fm->model, fm->me_speed, fm->me_mass, nominal);
+}
+
+void fm_me_event_indicators(fmu_model *fm, double *z)
+{
+    me_follow_inputs(fm);
+    contact_me_indicators(&fm->model, z);
+}
+
+void fm_me_event(fmu_model *fm)
+{
+    const contact_state before = fm->model.s;
+    me_follow_inputs(fm);
+    contact_me_event(&fm->model);
+    report_events(fm, &before);
+}
+
+void fm_me_step_completed(fmu_model *fm)
+{
+    contact_me_accept(&fm->model);
+}
+
+/* The derivatives and the modes by value reference (parameters.def's
+ * DERIVATIVE and STATE rows): 1 and *value, or 0 for another reference. */
+static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value)
+{
+    double x[CONTACT_ME_STATES];
+    int derivative = vr >= VR_phi + VR_DERIVATIVE_OFFSET;
+    unsigned mode = vr - (derivative ? VR_phi + VR_DERIVATIVE_OFFSET : VR_phi);
+    if (!(vr >= VR_der_x && vr <= VR_der_E_diss) && !(vr >= VR_phi && mode < CONTACT_MAX_MODES))
+        return 0;
+    preview_start(fm);
+    me_follow_inputs(fm);
+    if (vr >= VR_phi && !derivative) {
+        contact_me_get_states(&fm->model, x);
+        *value = x[CONTACT_ME_MODES + mode];
+        return 1;
+    }
+    contact_me_derivatives(&fm->model, x);
+    switch (vr) {
+    case VR_der_x: *value = x[CONTACT_ME_X]; break;
+    case VR_der_v_striker: *value = x[CONTACT_ME_V]; break;
+    case VR_der_x2: *value = x[CONTACT_ME_X2]; break;
+    case VR_der_E_diss: *value = x[CONTACT_ME_E_DISS]; break;
+    default: *value = x[CONTACT_ME_MODES + mode]; break;
+    }
+    return 1;
 }
 
 /* ------------------------------------------------------------ FMU state */
