@@ -793,7 +793,8 @@ void fm_me_step_completed(fmu_model *fm)
 }
 
 /* The derivatives and the modes by value reference (parameters.def's
- * DERIVATIVE and STATE rows): 1 and *value, or 0 for another reference. */
+ * DERIVATIVE and STATE rows) at the model's state: 1 and *value, or 0 for
+ * another reference. */
 static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value)
 {
     double x[CONTACT_ME_STATES];
@@ -801,8 +802,7 @@ static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value)
     unsigned mode = vr - (derivative ? VR_phi + VR_DERIVATIVE_OFFSET : VR_phi);
     if (!(vr >= VR_der_x && vr <= VR_der_E_diss) && !(vr >= VR_phi && mode < CONTACT_MAX_MODES))
         return 0;
-    preview_start(fm);
-    me_follow_inputs(fm);
+    preview_start(fm); /* and nothing else changes the model: a co-simulation master reads these too */
     if (vr >= VR_phi && !derivative) {
         contact_me_get_states(&fm->model, x);
         *value = x[CONTACT_ME_MODES + mode];
