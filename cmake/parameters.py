@@ -30,6 +30,8 @@ DERIVATIVE_OFFSET = 1000  # a STATE row's der(name[i]) is this many value refere
 PLACES = ("model", "fmu", "library", "solver", "package")
 # The initial unknowns that depend on a variable at the start: x = -gap0, v_striker = v - v2.
 INITIAL_DEPENDENCIES = {"x": ("gap0",), "v_striker": ("v", "v2")}
+# Model Exchange's derivatives that depend on a variable at the start: der(x) = v - v2, der(v_striker) = g.
+EXCHANGE_DEPENDENCIES = {"der(x)": ("v", "v2"), "der(v_striker)": ("g",)}
 ARGUMENT = re.compile(r'\s*((?:"[^"\\]*"\s*)+|[^,"]*?)\s*(,|$)')
 
 
@@ -139,6 +141,10 @@ def dependencies(row, by_name, key):
     return " ".join(by_name[d][key] for d in INITIAL_DEPENDENCIES.get(row["name"], ()))
 
 
+def exchange_dependencies(variable, by_name, key):
+    return " ".join(by_name[d][key] for d in EXCHANGE_DEPENDENCIES.get(variable["name"], ()))
+
+
 def fmi2_section(rows):
     """From <ModelVariables> to </ModelStructure> of modelDescription.xml."""
     fmu = fmu_rows(rows)
@@ -153,12 +159,14 @@ def fmi2_section(rows):
     lines += [f'      <Unknown index="{r["index"]}" dependencies=""/>' for r in outputs]
     lines += ["    </Outputs>"]
     if derivatives:
-        lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
+        lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md); at the "
+                  "start der(x) = v - v2 (1, 36), der(v_striker) = g (11), the rest 0 -->"]
         lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives] + ["    </Derivatives>"]
     lines += ["    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies="{dependencies(r, by_name, "index")}"/>'
               for r in outputs]
-    lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives]
+    lines += [f'      <Unknown index="{v["index"]}" dependencies="{exchange_dependencies(v, by_name, "index")}"/>'
+              for v in derivatives]
     return "\n".join(lines + ["    </InitialUnknowns>", "  </ModelStructure>"])
 
 
