@@ -21,9 +21,9 @@ FMI2, FMI3, PAGE = pathlib.Path("modelDescription.xml"), pathlib.Path("fmi3/mode
     pathlib.Path("docs/variables.md")
 COLUMNS = ("name", "type", "unit", "default", "min", "max", "vr", "index", "variability", "words", "rule",
            "description")
-KINDS = ("input", "parameter", "stop", "option", "output", "derivative", "state")
-# Model Exchange's kinds: der(name) of an output, and a local state of MODES elements.
-EXCHANGE_KINDS = ("derivative", "state")
+KINDS = ("input", "parameter", "stop", "option", "output", "derivative", "state", "indicator")
+# Model Exchange's kinds: der(name) of an output, a local state of MODES elements, an event indicator.
+EXCHANGE_KINDS = ("derivative", "state", "indicator")
 MODES = int(re.search(r"#define CONTACT_MAX_MODES (\d+)", pathlib.Path(__file__).parent.joinpath(
     "..", "model", "contact.h").read_text()).group(1))
 DERIVATIVE_OFFSET = 1000  # a STATE row's der(name[i]) is this many value references on (fmu_model.h)
@@ -74,10 +74,14 @@ def fmu_rows(rows):
 
 def exchange_variables(rows):
     """Model Exchange's variables as dicts (name, vr, index, unit, description, start, and
-    derivative: the name of the state whose derivative it is, or None), in index order: a
-    DERIVATIVE row's der(name), a STATE row's name[1..MODES] and then der(name[i])."""
+    derivative: the name of the state whose derivative it is, or None; indicator), in index
+    order: a DERIVATIVE row's der(name), a STATE row's name[1..MODES] and then der(name[i]),
+    an INDICATOR row's name."""
     found = []
     for r in rows:
+        if r["kind"] == "indicator":
+            found.append(dict(name=r["name"], vr=r["vr"], index=r["index"], unit=r["unit"],
+                              description=r["description"], start="", derivative=None, indicator=True))
         if r["kind"] == "derivative":
             found.append(dict(name=f"der({r['name']})", vr=r["vr"], index=r["index"], unit=r["unit"],
                               description=r["description"], start="", derivative=r["name"]))
@@ -103,7 +107,9 @@ def state_index(variables, fmu, name):
 
 
 def fmi2_exchange_variable(v, fmu, variables):
-    if v["derivative"]:
+    if v.get("indicator"):
+        real, initial = f'<Real unit="{v["unit"]}"/>', ""
+    elif v["derivative"]:
         real = f'<Real unit="{v["unit"]}" derivative="{state_index(variables, fmu, v["derivative"])}"/>'
         initial = ""
     else:
@@ -182,21 +188,42 @@ def fmi3_variable(row):
             f'      description="{html.escape(row["description"], quote=False)}"/>')
 
 
+def fmi3_exchange_variable(v, fmu, variables):
+    vr = {r["name"]: r["vr"] for r in fmu}
+    vr.update({w["name"]: w["vr"] for w in variables})
+    extra = f' derivative="{vr[v["derivative"]]}"' if v["derivative"] else ""
+    if not v["derivative"] and not v.get("indicator"):
+        extra = f' initial="exact" start="{v["start"]}"'
+    return (f'    <Float64 name="{v["name"]}" valueReference="{v["vr"]}" causality="local" variability="continuous" '
+            f'unit="{v["unit"]}"{extra}\n      description="{html.escape(v["description"], quote=False)}"/>')
+
+
 def fmi3_section(rows):
     """From <ModelVariables> to </ModelStructure> of fmi3/modelDescription.xml."""
     fmu = fmu_rows(rows)
     by_name = {r["name"]: r for r in fmu}
     outputs = [r for r in fmu if r["kind"] == "output"]
+    exchange = exchange_variables(rows)
+    derivatives = [v for v in exchange if v["derivative"]]
     lines = ["  <ModelVariables>",
              '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous" unit="s"',
              '      description="simulation time"/>']
-    lines += [fmi3_variable(r) for r in fmu] + ["  </ModelVariables>", "", "  <ModelStructure>",
-                                                "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
-                                                "         mode): no direct feedthrough from the inputs -->"]
+    lines += [fmi3_variable(r) for r in fmu] + [fmi3_exchange_variable(v, fmu, exchange) for v in exchange]
+    lines += ["  </ModelVariables>", "", "  <ModelStructure>",
+              "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
+              "         mode): no direct feedthrough from the inputs -->"]
     lines += [f'    <Output valueReference="{r["vr"]}"/>' for r in outputs]
+    if derivatives:
+        lines += ["    <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
+        lines += [f'    <ContinuousStateDerivative valueReference="{v["vr"]}"/>' for v in derivatives]
     lines += [f"    <!-- {initial_comment(by_name, 'vr')} -->"]
     lines += [f'    <InitialUnknown valueReference="{r["vr"]}" dependencies="{dependencies(r, by_name, "vr")}"/>'
               for r in outputs]
+    if derivatives:
+        lines += ["    <!-- at the start der(x) = v - v2 (1, 36), der(v_striker) = g (11), the rest 0 -->"]
+    lines += [f'    <InitialUnknown valueReference="{v["vr"]}" '
+              f'dependencies="{exchange_dependencies(v, by_name, "vr")}"/>' for v in derivatives]
+    lines += [f'    <EventIndicator valueReference="{v["vr"]}"/>' for v in exchange if v.get("indicator")]
     return "\n".join(lines + ["  </ModelStructure>"])
 
 

@@ -23,6 +23,13 @@ from fmpy.validation import validate_fmu
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOLVE = os.environ.get("FRACCONTACT_SOLVE", str(ROOT / "build" / "fraccontact-solve"))
+FMU3 = pathlib.Path(os.environ.get("FRACCONTACT_FMU3", ROOT / "build" / "fraccontact-fmi3.fmu"))
+
+
+@pytest.fixture(params=["fmi2", "fmi3"])
+def either_fmu(request, fmu_path):
+    """The FMI 2.0 FMU and the FMI 3.0 one: the same figures through both."""
+    return fmu_path if request.param == "fmi2" else FMU3
 
 # The state vector (model/contact.h, CONTACT_ME_*): x, v, x2, E_diss, then
 # CONTACT_MAX_MODES = 160 slots of the springpot's modes.
@@ -67,10 +74,10 @@ def errors(found, ref):
 
 # ------------------------------------------------------------- the figures
 
-def test_the_h20_drop_test_matches_the_gsl_reference(fmu_path):
+def test_the_h20_drop_test_matches_the_gsl_reference(either_fmu):
     """F_peak, t_contact, x2 within 1e-6 (relative) and eps within 1e-6 of
     the reference at the host's rtol 1e-10."""
-    found = errors(impact(exchange(fmu_path, HOST_RTOL, 2e-3)), reference())
+    found = errors(impact(exchange(either_fmu, HOST_RTOL, 2e-3)), reference())
     assert max(found.values()) < 1e-6, found
 
 
@@ -87,20 +94,20 @@ def test_the_error_falls_with_the_hosts_tolerance(fmu_path):
         assert fine < max(coarse / 10.0, 1e-10), table
 
 
-def test_two_free_bodies_match_the_reference(fmu_path):
+def test_two_free_bodies_match_the_reference(either_fmu):
     """A striker meeting a moving second body of finite mass: the reduced
     mass at the approach speed v - v2, as the reference takes them."""
     bodies = dict(v=3.0, m=M, v2=1.0, m2=2.0)
-    found = errors(impact(exchange(fmu_path, HOST_RTOL, 2e-3, **bodies)),
+    found = errors(impact(exchange(either_fmu, HOST_RTOL, 2e-3, **bodies)),
                    reference(*sum((["--" + k, v] for k, v in bodies.items()), [])))
     assert max(found.values()) < 1e-6, found
 
 
-def test_the_driven_scene_matches_the_reference(fmu_path):
+def test_the_driven_scene_matches_the_reference(either_fmu):
     """The indentation driven at the input rate v (no striker inertia):
     force, dent and dissipated work at t_end against the reference's."""
     t_end = 1e-3
-    result = exchange(fmu_path, HOST_RTOL, t_end, scene=2, v=0.1, m=0.0)
+    result = exchange(either_fmu, HOST_RTOL, t_end, scene=2, v=0.1, m=0.0)
     ref = reference("--scene", "driven", "--v", 0.1, "--m", 0, "--t-end", t_end)["end"]
     end = result[-1]
     assert end["time"] == pytest.approx(t_end, rel=0, abs=1e-15)  # fmpy ends on the stop time
@@ -117,13 +124,13 @@ def springpot_cosimulation(fmu_path, stop_time, **start):
                         output=["F_peak", "x2", "E_diss", "eps", "contact"])
 
 
-def test_the_compressed_springpot_matches_the_cosimulation(fmu_path):
+def test_the_compressed_springpot_matches_the_cosimulation(either_fmu):
     """Its kernel's modes as ODE states: F_peak and the dent x2 at 3 ms
     (recovering) within 1e-6 (relative), eps within 1e-6 of Radau IIA's.
     Both take the kernel of tolerance > 0 (floor 1e-9 s)."""
     start = dict(damper=2, tolerance=1e-12, dt_max=1e-7)
-    me = exchange(fmu_path, HOST_RTOL, 3e-3, **start)[-1]
-    cs = springpot_cosimulation(fmu_path, 3e-3)[-1]
+    me = exchange(either_fmu, HOST_RTOL, 3e-3, **start)[-1]
+    cs = springpot_cosimulation(either_fmu, 3e-3)[-1]
     for key in ("F_peak", "x2"):
         assert abs(me[key] / cs[key] - 1.0) < 1e-6, key
     assert abs(me["eps"] - cs["eps"]) < 1e-6
@@ -290,5 +297,5 @@ def test_the_fmu_state_restores_the_continuous_states(instance):
     i.fmu.freeFMUstate(saved)
 
 
-def test_fmpy_validates_the_fmu(fmu_path):
-    assert validate_fmu(str(fmu_path)) == []
+def test_fmpy_validates_the_fmu(either_fmu):
+    assert validate_fmu(str(either_fmu)) == []

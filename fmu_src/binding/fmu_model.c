@@ -748,8 +748,8 @@ fm_status fm_me_set_states(fmu_model *fm, const double *x)
     size_t i;
     for (i = 0; i < CONTACT_ME_STATES; i++)
         if (!isfinite(x[i]))
-            return report(fm, FM_ERROR, "logStatusError", "SetContinuousStates: the state %lu is %g: it must be finite",
-                          (unsigned long)i, x[i]);
+            return report(fm, FM_ERROR, "logStatusError",
+                          "SetContinuousStates: the state %lu is %g: it must be finite", (unsigned long)i, x[i]);
     contact_me_set_states(&fm->model, x);
     me_follow_inputs(fm);
     return FM_OK;
@@ -800,9 +800,14 @@ static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value)
     double x[CONTACT_ME_STATES];
     int derivative = vr >= VR_phi + VR_DERIVATIVE_OFFSET;
     unsigned mode = vr - (derivative ? VR_phi + VR_DERIVATIVE_OFFSET : VR_phi);
-    if (!(vr >= VR_der_x && vr <= VR_der_E_diss) && !(vr >= VR_phi && mode < CONTACT_MAX_MODES))
+    if (!(vr >= VR_der_x && vr <= VR_event_x1_rate) && !(vr >= VR_phi && mode < CONTACT_MAX_MODES))
         return 0;
     preview_start(fm); /* and nothing else changes the model: a co-simulation master reads these too */
+    if (vr == VR_event_x1 || vr == VR_event_x1_rate) {
+        contact_me_indicators(&fm->model, x);
+        *value = x[vr - VR_event_x1];
+        return 1;
+    }
     if (vr >= VR_phi && !derivative) {
         contact_me_get_states(&fm->model, x);
         *value = x[CONTACT_ME_MODES + mode];

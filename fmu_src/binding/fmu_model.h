@@ -20,6 +20,7 @@ enum fmu_vr {
 #define OUTPUT_FMU FMU_VR
 #define DERIVATIVE_FMU(name, type, unit, value, min, max, vr, ...) VR_der_##name = vr,
 #define STATE_FMU FMU_VR
+#define INDICATOR_FMU FMU_VR
 #include "parameters.def"
 };
 #undef FMU_VR

@@ -24,7 +24,8 @@
 static fmi2Status refused(fmu_instance *in, const char *name)
 {
     if (in && !in->model_exchange)
-        fi_fail(in, "%s: the instance was instantiated for co-simulation, not fmi2ModelExchange", name);
+        fi_fail(in, "%s is not supported by an instance for co-simulation: instantiate the FMU as fmi2ModelExchange",
+                name);
     return fmi2Error;
 }
 
