@@ -535,6 +535,11 @@ void contact_me_get_states(const contact_model *cm, double *x);
 /* The states' rates at the model's state. */
 void contact_me_derivatives(const contact_model *cm, double *dx);
 
+/* The derivatives' change for a change dx of the states and, in the driven
+ * scene, dv of the input approach speed v - v2 (the Jacobian times them, in
+ * closed form): CONTACT_ME_STATES values each. */
+void contact_me_directional(const contact_model *cm, const double *dx, double dv, double *df);
+
 /* The states' nominal values for a striker of mass m (0: the rate
  * prescribed) meeting the specimen at the approach speed v0: the impact's
  * indentation scale for the lengths, the speed, the kinetic energy. */

@@ -77,6 +77,31 @@ void contact_me_derivatives(const contact_model *cm, double *dx)
         dx[CONTACT_ME_MODES + i] = i < cm->modes.modes ? rate - cm->modes.b[i] * cm->modes.phi[i] : 0.0;
 }
 
+/* The spring force's slope dF/dx1 = n K x1^(n-1) in contact, 0 outside. */
+static double force_slope(const contact_model *cm, double x1)
+{
+    const double n = cm->p.spring_exponent;
+    return x1 > 0.0 ? n * cm->k_fixed * (n == 1.5 ? sqrt(x1) : pow(x1, n - 1.0)) : 0.0;
+}
+
+void contact_me_directional(const contact_model *cm, const double *dx, double dv, double *df)
+{
+    const contact_state *s = &cm->s;
+    const contact_modes *m = &cm->modes;
+    const double dF = force_slope(cm, s->x1) * (dx[CONTACT_ME_X] - dx[CONTACT_ME_X2]);
+    double d_rate, pull = 0.0;
+    size_t i;
+    for (i = 0; i < m->modes; i++)
+        pull += m->a[i] * dx[CONTACT_ME_MODES + i];
+    d_rate = springpot(cm) ? (dF / cm->p.c_alpha - pull) / m->eta : dF * cm->inv_c;
+    df[CONTACT_ME_X] = cm->p.scene == CONTACT_SCENE_DROP ? dx[CONTACT_ME_V] : dv;
+    df[CONTACT_ME_V] = -cm->inv_m * dF;
+    df[CONTACT_ME_X2] = d_rate;
+    df[CONTACT_ME_E_DISS] = dF * s->x2_rate + s->F * d_rate;
+    for (i = 0; i < CONTACT_MAX_MODES; i++)
+        df[CONTACT_ME_MODES + i] = i < m->modes ? d_rate - m->b[i] * dx[CONTACT_ME_MODES + i] : 0.0;
+}
+
 /* The elastic indentation of the impact's scale: where the spring's energy
  * K x1^(n+1)/(n+1) holds the approach's kinetic energy m v^2/2 (the
  * largest a dashpot's impact reaches), or where the spring's force equals

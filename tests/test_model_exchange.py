@@ -310,5 +310,65 @@ def test_the_fmu_state_restores_the_continuous_states(instance):
     i.fmu.freeFMUstate(saved)
 
 
+def jacobian_columns(i, x, knowns):
+    """Per known (a state's place, or "v"): the directional derivative of
+    all the derivatives, and the central difference of the derivatives over
+    1e-4 of the known's scale (the state's size here)."""
+    names = [v for v in i.vr if v.startswith("der(")]
+    unknowns = [i.vr[n] for n in names]
+    place = {n: k for k, n in enumerate(["der(x)", "der(v_striker)", "der(x2)", "der(E_diss)"]
+                                       + [f"der(phi[{m + 1}])" for m in range(160)])}
+    state_vr = [i.vr[n] for n in ["x", "v_striker", "x2", "E_diss"] + [f"phi[{m + 1}]" for m in range(160)]]
+    columns = []
+    for known in knowns:
+        vr = i.vr["v"] if known == "v" else state_vr[known]
+        exact = np.array(i.fmu.getDirectionalDerivative(unknowns, [vr], [1.0]))
+        h = 1e-4 * (0.1 if known == "v" else max(abs(x[known]), 1e-7))
+        sides = []
+        for sign in (1, -1):
+            if known == "v":
+                i.fmu.setReal([vr], [0.1 + sign * h])
+                i.set_states(x)
+            else:
+                y = x.copy()
+                y[known] += sign * h
+                i.set_states(y)
+            sides.append(i.derivatives())
+        if known == "v":
+            i.fmu.setReal([vr], [0.1])
+        i.set_states(x)
+        difference = (sides[0] - sides[1]) / (2 * h)
+        columns.append((known, exact, np.array([difference[place[n]] for n in names])))
+    return columns
+
+
+@pytest.mark.parametrize("values", [dict(law=2), dict(law=2, damper=2), dict(law=2, scene=2, v=0.1, m=0.0)],
+                         ids=["dashpot", "springpot", "driven"])
+def test_the_directional_derivatives_are_the_finite_differences(instance, values):
+    """At a state in contact (the springpot's modes stretched), each
+    column of the Jacobian the FMU gives against the central difference of
+    its derivatives: they agree to the difference's error, h^2/6 times the
+    third derivative of the force's x1^(3/2) at h = 1e-4 of the scale (below
+    1e-9 relative) and rounding over h (1e-12), within 1e-7 of the column's
+    size; the modes beyond the kernel's are 0 in both."""
+    i = instance(**values).start()
+    x = i.states()
+    x[:4] = [2e-4, 0.3, 5e-5, 0.01]
+    if values.get("damper") == 2:
+        x[4:44] = np.linspace(1e-6, 2e-5, 40)
+    i.set_states(x)
+    knowns = [0, 1, 2, 3] + ([4, 20] if values.get("damper") == 2 else []) + (["v"] if "scene" in values else [])
+    for known, exact, difference in jacobian_columns(i, x, knowns):
+        scale = np.max(np.abs(exact)) + np.max(np.abs(difference))
+        assert np.max(np.abs(exact - difference)) <= 1e-7 * scale, (known, exact[:6], difference[:6])
+
+
+def test_directional_derivatives_name_what_they_take(instance):
+    i = instance(law=2).start()
+    with pytest.raises(Exception):
+        i.fmu.getDirectionalDerivative([i.vr["der(x)"]], [i.vr["k"]], [1.0])
+    assert "value reference 8 is not a continuous state or the input v or v2" in i.log[-1]
+
+
 def test_fmpy_validates_the_fmu(either_fmu):
     assert validate_fmu(str(either_fmu)) == []

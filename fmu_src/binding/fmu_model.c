@@ -792,6 +792,58 @@ void fm_me_step_completed(fmu_model *fm)
     contact_me_accept(&fm->model);
 }
 
+/* The state of value reference vr (its place among the states), or -1. */
+static long me_state_of(unsigned vr)
+{
+    switch (vr) {
+    case VR_x: return CONTACT_ME_X;
+    case VR_v_striker: return CONTACT_ME_V;
+    case VR_x2: return CONTACT_ME_X2;
+    case VR_E_diss: return CONTACT_ME_E_DISS;
+    default: return vr >= VR_phi && vr - VR_phi < CONTACT_MAX_MODES ? CONTACT_ME_MODES + (long)(vr - VR_phi) : -1;
+    }
+}
+
+/* The derivative of value reference vr (the place of its state), or -1. */
+static long me_derivative_of(unsigned vr)
+{
+    switch (vr) {
+    case VR_der_x: return CONTACT_ME_X;
+    case VR_der_v_striker: return CONTACT_ME_V;
+    case VR_der_x2: return CONTACT_ME_X2;
+    case VR_der_E_diss: return CONTACT_ME_E_DISS;
+    default: return vr >= VR_phi + VR_DERIVATIVE_OFFSET ? me_state_of(vr - VR_DERIVATIVE_OFFSET) : -1;
+    }
+}
+
+fm_status fm_me_directional(fmu_model *fm, const unsigned *unknowns, size_t n_unknowns, const unsigned *knowns,
+                            size_t n_knowns, const double *seed, double *sensitivity)
+{
+    double dx[CONTACT_ME_STATES] = {0.0}, df[CONTACT_ME_STATES], dv = 0.0;
+    size_t i;
+    me_follow_inputs(fm);
+    for (i = 0; i < n_knowns; i++) {
+        const long state = me_state_of(knowns[i]);
+        if (state >= 0)
+            dx[state] += seed[i];
+        else if (knowns[i] == VR_v || knowns[i] == VR_v2) /* the driven scene's rate v - v2 */
+            dv += knowns[i] == VR_v ? seed[i] : -seed[i];
+        else
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDirectionalDerivative: value reference %u is not a continuous state or the input v "
+                          "or v2: the derivatives are differentiated with respect to those", knowns[i]);
+    }
+    for (i = 0; i < n_unknowns; i++)
+        if (me_derivative_of(unknowns[i]) < 0)
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDirectionalDerivative: value reference %u is not a state derivative (der(x), "
+                          "der(v_striker), der(x2), der(E_diss), der(phi[i]))", unknowns[i]);
+    contact_me_directional(&fm->model, dx, dv, df);
+    for (i = 0; i < n_unknowns; i++)
+        sensitivity[i] = df[me_derivative_of(unknowns[i])];
+    return FM_OK;
+}
+
 /* The derivatives and the modes by value reference (parameters.def's
  * DERIVATIVE and STATE rows) at the model's state: 1 and *value, or 0 for
  * another reference. */

@@ -397,6 +397,17 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nKnown, const fmi2Real dvKnown[], fmi2Real dvUnknown[])
 {
     instance *in = c;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in && in->base.model_exchange) { /* its ModelExchange element provides them */
+        REQUIRE(AFTER_INIT_ENTERED, "fmi2GetDirectionalDerivative");
+        if (fi_null_arrays(&in->base, nUnknown, vUnknown_ref, dvUnknown, "fmi2GetDirectionalDerivative")
+            || fi_null_arrays(&in->base, nKnown, vKnown_ref, dvKnown, "fmi2GetDirectionalDerivative"))
+            return fmi2Error;
+        return fm_me_directional(in->base.fm, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown) == FM_OK
+                   ? fmi2OK
+                   : fmi2Error;
+    }
+#endif
     (void)vUnknown_ref;
     (void)nUnknown;
     (void)vKnown_ref;

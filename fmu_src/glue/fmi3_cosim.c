@@ -636,6 +636,21 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)
 {
     instance *in = c;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in && in->base.model_exchange) { /* its ModelExchange element provides them */
+        REQUIRE(AFTER_INIT_ENTERED, "fmi3GetDirectionalDerivative");
+        if (fi_null_arrays(&in->base, nUnknowns, unknowns, sensitivity, "fmi3GetDirectionalDerivative")
+            || fi_null_arrays(&in->base, nKnowns, knowns, seed, "fmi3GetDirectionalDerivative"))
+            return fmi3Error;
+        if (nSeed != nKnowns || nSensitivity != nUnknowns)
+            return fail(in, "fmi3GetDirectionalDerivative: nSeed = %lu and nSensitivity = %lu must be nKnowns = %lu "
+                            "and nUnknowns = %lu (every variable of this FMU is a scalar)", (unsigned long)nSeed,
+                        (unsigned long)nSensitivity, (unsigned long)nKnowns, (unsigned long)nUnknowns);
+        return fm_me_directional(in->base.fm, unknowns, nUnknowns, knowns, nKnowns, seed, sensitivity) == FM_OK
+                   ? fmi3OK
+                   : fmi3Error;
+    }
+#endif
     (void)unknowns;
     (void)nUnknowns;
     (void)knowns;

@@ -36,4 +36,11 @@ void fm_me_event(fmu_model *fm);
 /* The host accepted the state it set last. */
 void fm_me_step_completed(fmu_model *fm);
 
+/* The directional derivative of the state derivatives `unknowns` for the
+ * changes `seed` of the states or inputs `knowns` (value references) into
+ * sensitivity (n_unknowns values); FM_ERROR and a report for a reference
+ * that is neither. */
+fm_status fm_me_directional(fmu_model *fm, const unsigned *unknowns, size_t n_unknowns, const unsigned *knowns,
+                            size_t n_knowns, const double *seed, double *sensitivity);
+
 #endif
