@@ -372,3 +372,45 @@ def test_directional_derivatives_name_what_they_take(instance):
 
 def test_fmpy_validates_the_fmu(either_fmu):
     assert validate_fmu(str(either_fmu)) == []
+
+
+def test_the_fmi3_fmu_refuses_restores_and_counts_as_the_fmi2_one(model_description):
+    """FMI 3.0's instance: the G1 law refused at the start naming law, the
+    instance kept; then its counts, and its FMU state restoring the
+    continuous states and their derivatives to the bit."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi3 import FMU3Model
+    md = read_model_description(str(FMU3))
+    folder = extract(str(FMU3))
+    said = []
+    fmu = FMU3Model(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.modelExchange.modelIdentifier,
+                    instanceName="me3")
+    fmu.instantiate(logMessage=lambda env, status, category, message: said.append(message.decode()))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu.enterInitializationMode()
+    with pytest.raises(Exception):
+        fmu.exitInitializationMode()
+    assert "law = 1" in said[-1] and "law = 2" in said[-1], said
+    fmu.setInt32([vr["law"]], [2])
+    fmu.setInt32([vr["damper"]], [2])
+    fmu.exitInitializationMode()
+    fmu.updateDiscreteStates()
+    fmu.enterContinuousTimeMode()
+    assert fmu.getNumberOfContinuousStates() == STATES and fmu.getNumberOfEventIndicators() == INDICATORS
+    pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    x = np.zeros(STATES)
+    fmu.getContinuousStates(pointer(x), STATES)
+    x[:4] = [2e-4, 0.3, 5e-5, 0.01]
+    x[4:40] = 1e-6
+    fmu.setContinuousStates(pointer(x), STATES)
+    saved, rates = fmu.getFMUState(), np.zeros(STATES)
+    fmu.getContinuousStateDerivatives(pointer(rates), STATES)
+    fmu.setContinuousStates(pointer(np.zeros(STATES)), STATES)
+    fmu.setFMUState(saved)
+    after, again = np.zeros(STATES), np.zeros(STATES)
+    fmu.getContinuousStates(pointer(after), STATES)
+    fmu.getContinuousStateDerivatives(pointer(again), STATES)
+    assert (after == x).all() and (again == rates).all()
+    fmu.freeFMUState(saved)
+    fmu.terminate()
+    fmu.freeInstance()

@@ -63,6 +63,7 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
+    int model_exchange;   /* started for Model Exchange (fm_me_start) */
     double me_speed, me_mass; /* Model Exchange: the approach speed and mass its nominal values are of */
     contact_model model;
     prediction next;
@@ -733,8 +734,15 @@ fm_status fm_me_start(fmu_model *fm, double t0, double t_stop)
     /* the host's solver moves the bodies: no proxy striker in the driven scene */
     if (fm->params.scene == CONTACT_SCENE_DRIVEN)
         contact_drive(&fm->model, approach(&fm->in), 0.0, 0.0);
+    fm->model_exchange = 1;
     fm->me_speed = approach(&fm->in);
     fm->me_mass = fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0;
+    if (status == FM_OK && fm->params.scene == CONTACT_SCENE_DRIVEN
+        && (fm->in.m != 0.0 || other_accel(&fm->in) != 0.0 || fm->coupling != COUPLING_GAUSS_SEIDEL))
+        return report(fm, FM_WARNING, "logStatusWarning",
+                      "m = %g, a = %g, a2 = %g and coupling = %d have no effect in Model Exchange's driven scene "
+                      "(scene = 2): the host moves the bodies, and the indentation's rate is v - v2 as given",
+                      fm->in.m, fm->in.a, fm->in.a2, fm->coupling);
     return status;
 }
 
@@ -988,7 +996,8 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
         || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
-        || !(trial.model.s.F >= 0.0 && trial.model.s.F <= trial.model.s.F_peak)
+        /* (Model Exchange takes the peak at accepted states: a state the host set may exceed it) */
+        || !(trial.model.s.F >= 0.0 && (trial.model.s.F <= trial.model.s.F_peak || trial.model_exchange))
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0
         || trial.step.H < 0.0 || trial.step.span < 0.0 || trial.predicted < 0 || trial.computed < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");
