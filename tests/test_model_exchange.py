@@ -414,3 +414,18 @@ def test_the_fmi3_fmu_refuses_restores_and_counts_as_the_fmi2_one(model_descript
     fmu.freeFMUState(saved)
     fmu.terminate()
     fmu.freeInstance()
+
+
+def test_the_nominals_are_the_impacts_scales(instance):
+    """The lengths' nominal is the elastic Hertz impact's largest
+    indentation (5 m v0^2 / (4 k))^(2/5) (the spring's energy holding the
+    striker's, docs/model_exchange.md), about a tenth of a millimetre here,
+    however far the striker starts (gap0 = 1 m); the speed's is v0, the
+    energy's m v0^2 / 2: each a few roundings of its closed form."""
+    i = instance(law=2, gap0=1.0).start()
+    nominal = np.zeros(STATES)
+    i.fmu.getNominalsOfContinuousStates(nominal.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), STATES)
+    length = (5 * M * V0 ** 2 / (4 * K)) ** 0.4
+    expected = [length, V0, length, 0.5 * M * V0 ** 2] + [length] * 160
+    assert nominal == pytest.approx(expected, rel=1e-14, abs=0)  # pow's and a few products' roundings
+    assert i.states()[0] == -1.0  # the state x itself in metres

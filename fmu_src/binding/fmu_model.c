@@ -778,7 +778,12 @@ fm_status fm_me_derivatives(fmu_model *fm, double *dx)
 
 void fm_me_nominals(fmu_model *fm, double *nominal)
 {
-    contact_me_nominals(&fm->model, fm->me_speed, fm->me_mass, nominal);
+    me_follow_inputs(fm);
+    if (!fm->model_exchange) /* before the start: of the inputs so far */
+        contact_me_nominals(&fm->model, approach(&fm->in),
+                            fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0, nominal);
+    else
+        contact_me_nominals(&fm->model, fm->me_speed, fm->me_mass, nominal);
 }
 
 void fm_me_event_indicators(fmu_model *fm, double *z)

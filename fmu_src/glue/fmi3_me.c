@@ -119,7 +119,7 @@ fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[], size_t nContinuousStates)
 {
     fmu_instance *in = c;
-    REQUIRE(AFTER_INIT_ENTERED, "fmi3GetNominalsOfContinuousStates");
+    REQUIRE(INSTANTIATED | AFTER_INIT_ENTERED, "fmi3GetNominalsOfContinuousStates");
     if (wrong_count(in, nominals, nContinuousStates, fm_me_states, "nContinuousStates",
                     "fmi3GetNominalsOfContinuousStates"))
         return fmi3Error;
