@@ -1,7 +1,9 @@
 /* FMI 2.0 co-simulation glue: instances, the call-sequence state machine,
  * logging, communication times, the FMU state, and the translation of FMI
  * calls onto a model (fmu_interface.h). It knows the standard, not the
- * physics; the FMU it serves names itself in guid.h. */
+ * physics; the FMU it serves names itself in guid.h. Where that FMU has
+ * Model Exchange too (FMU_MODEL_EXCHANGE), the instances, variables and
+ * FMU state here serve it as well, and fmi2_me.c has its own functions. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>

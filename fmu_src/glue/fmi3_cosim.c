@@ -2,7 +2,9 @@
  * (fmu_interface.h), with FMI 3.0's state machine, event mode, early return
  * at the model's events and the intermediate update callback. Instances,
  * logging and the FMU state are fmu_instance.c's, shared with fmi2_cosim.c.
- * It knows the standard, not the physics. */
+ * It knows the standard, not the physics. Where the FMU has Model Exchange
+ * too (FMU_MODEL_EXCHANGE), the instances, event mode, variables and FMU
+ * state here serve it as well, and fmi3_me.c has its own functions. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
