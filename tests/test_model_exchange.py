@@ -25,17 +25,17 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOLVE = os.environ.get("FRACCONTACT_SOLVE", str(ROOT / "build" / "fraccontact-solve"))
 FMU3 = pathlib.Path(os.environ.get("FRACCONTACT_FMU3", ROOT / "build" / "fraccontact-fmi3.fmu"))
 
+# The state vector (model/contact.h, CONTACT_ME_*): x, v, x2, E_diss, then
+# CONTACT_MAX_MODES = 160 slots of the springpot's modes.
+STATES, INDICATORS = 164, 2
+HOST_RTOL = 1e-10  # the host's tolerance at which the figures are within 1e-6 of the references
+K, C, M, V0 = 3.299e8, 6080.0, 0.7437, 0.626418  # the h20 test (docs/model.md §1)
+
 
 @pytest.fixture(params=["fmi2", "fmi3"])
 def either_fmu(request, fmu_path):
     """The FMI 2.0 FMU and the FMI 3.0 one: the same figures through both."""
     return fmu_path if request.param == "fmi2" else FMU3
-
-# The state vector (model/contact.h, CONTACT_ME_*): x, v, x2, E_diss, then
-# CONTACT_MAX_MODES = 160 slots of the springpot's modes.
-STATES, INDICATORS = 164, 2
-HOST_RTOL = 1e-10  # the host's tolerance at which the figures meet the issue's 1e-6
-K, C, M, V0 = 3.299e8, 6080.0, 0.7437, 0.626418  # the h20 test (docs/model.md §1)
 
 
 def reference(*args):
