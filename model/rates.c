@@ -104,9 +104,9 @@ void contact_me_directional(const contact_model *cm, const double *dx, double dv
 
 /* The elastic indentation of the impact's scale: where the spring's energy
  * K x1^(n+1)/(n+1) holds the approach's kinetic energy m v^2/2 (the
- * largest a dashpot's impact reaches), or where the spring's force equals
- * the dashpot's at the rate v when no mass is given; 1 micrometre where
- * neither says (the striker at rest). */
+ * largest a dashpot's impact reaches), or where the spring's force is
+ * c v when no mass is given (c_alpha v for the springpot: a scale, not its
+ * force); 1 micrometre where neither says (the striker at rest). */
 static double indentation_scale(const contact_model *cm, double v, double m)
 {
     const double n = cm->p.spring_exponent, K = cm->k_fixed;
