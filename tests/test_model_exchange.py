@@ -267,6 +267,24 @@ def test_the_discrete_time_methods_are_refused_and_the_instance_stays_usable(ins
     assert i.states()[1] == V0
 
 
+def test_states_that_overflow_or_are_not_finite_are_errors(instance):
+    """A non-finite state is refused naming it, the states kept; finite
+    states whose rates overflow (a kilometre's indentation) are an error of
+    GetDerivatives, not infinities handed to the host."""
+    i = instance(law=2).start()
+    x = i.states()
+    bad = x.copy()
+    bad[2] = np.nan
+    with pytest.raises(Exception):
+        i.set_states(bad)
+    assert "the state 2 is nan" in i.log[-1] and (i.states() == x).all()
+    x[0] = 1e300
+    i.set_states(x)
+    with pytest.raises(Exception):
+        i.derivatives()
+    assert "overflows" in i.log[-1]
+
+
 def test_the_call_sequence_is_enforced(instance):
     """Continuous states are set in continuous-time mode only, the count
     must be the FMU's, and co-simulation's step is not Model Exchange's."""

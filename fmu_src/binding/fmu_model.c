@@ -771,8 +771,16 @@ void fm_me_get_states(fmu_model *fm, double *x)
 
 fm_status fm_me_derivatives(fmu_model *fm, double *dx)
 {
+    size_t i;
     me_follow_inputs(fm);
     contact_me_derivatives(&fm->model, dx);
+    /* extreme but finite states (an indentation of metres on a steel
+     * spring) can overflow a rate */
+    for (i = 0; i < CONTACT_ME_STATES; i++)
+        if (!isfinite(dx[i]))
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDerivatives: the derivative of the state %lu overflows (%g) at x = %g m, x2 = %g m",
+                          (unsigned long)i, dx[i], contact_total_indentation(&fm->model), fm->model.s.x2);
     return FM_OK;
 }
 
