@@ -63,7 +63,7 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
-    int model_exchange;   /* started for Model Exchange (fm_me_start) */
+    int model_exchange;   /* serves a Model Exchange instance (fm_me_instantiated) */
     double me_speed, me_mass; /* Model Exchange: the approach speed and mass its nominal values are of */
     contact_model model;
     prediction next;
@@ -722,6 +722,11 @@ static void me_follow_inputs(fmu_model *fm)
         fm->model.s.v = approach(&fm->in);
 }
 
+void fm_me_instantiated(fmu_model *fm)
+{
+    fm->model_exchange = 1;
+}
+
 fm_status fm_me_start(fmu_model *fm, double t0, double t_stop)
 {
     char why[512];
@@ -734,7 +739,6 @@ fm_status fm_me_start(fmu_model *fm, double t0, double t_stop)
     /* the host's solver moves the bodies: no proxy striker in the driven scene */
     if (fm->params.scene == CONTACT_SCENE_DRIVEN)
         contact_drive(&fm->model, approach(&fm->in), 0.0, 0.0);
-    fm->model_exchange = 1;
     fm->me_speed = approach(&fm->in);
     fm->me_mass = fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0;
     if (status == FM_OK && fm->params.scene == CONTACT_SCENE_DRIVEN
@@ -787,7 +791,7 @@ fm_status fm_me_derivatives(fmu_model *fm, double *dx)
 void fm_me_nominals(fmu_model *fm, double *nominal)
 {
     me_follow_inputs(fm);
-    if (!fm->model_exchange) /* before the start: of the inputs so far */
+    if (!fm->started) /* before the start: of the inputs so far */
         contact_me_nominals(&fm->model, approach(&fm->in),
                             fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0, nominal);
     else

@@ -107,6 +107,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     in->base.model_exchange = fmuType == fmi2ModelExchange;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     return in;
 }
 
@@ -187,6 +191,10 @@ fmi2Status fmi2Reset(fmi2Component c)
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi2Reset");
     fm_reset(in->base.fm);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;

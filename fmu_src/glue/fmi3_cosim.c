@@ -129,8 +129,10 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
 {
     instance *in = fmi3InstantiateCoSimulation(instanceName, instantiationToken, resourcePath, visible, loggingOn,
                                                fmi3True, fmi3False, NULL, 0, instanceEnvironment, logMessage, NULL);
-    if (in)
+    if (in) {
         in->base.model_exchange = 1;
+        fm_me_instantiated(in->base.fm);
+    }
     return in;
 }
 #else
@@ -280,6 +282,10 @@ fmi3Status fmi3Reset(fmi3Instance c)
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi3Reset");
     fm_reset(in->base.fm);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;

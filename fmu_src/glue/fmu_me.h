@@ -14,6 +14,10 @@
 /* The numbers modelDescription.xml declares. */
 extern const size_t fm_me_states, fm_me_indicators;
 
+/* The model serves a Model Exchange instance: said after the instance is
+ * made and after every reset. */
+void fm_me_instantiated(fmu_model *fm);
+
 /* End of initialization in Model Exchange: what fm_start checks and does,
  * and whether the model runs there (FM_ERROR and a report naming the
  * variable, its value and what to take instead, the model as it was). */
