@@ -528,8 +528,9 @@ enum { CONTACT_ME_X, CONTACT_ME_V, CONTACT_ME_X2, CONTACT_ME_E_DISS, CONTACT_ME_
 int contact_me_check(const contact_params *p, char *msg, size_t len);
 
 /* The states into the model (the force and the damper's rate follow from
- * them) and out of it, CONTACT_ME_STATES values each. */
-void contact_me_set_states(contact_model *cm, const double *x);
+ * them: 0, or -1 and the model as it was where those or the damper's power
+ * would not be finite) and out of it, CONTACT_ME_STATES values each. */
+int contact_me_set_states(contact_model *cm, const double *x);
 void contact_me_get_states(const contact_model *cm, double *x);
 
 /* The states' rates at the model's state. */

@@ -26,30 +26,35 @@ int contact_me_check(const contact_params *p, char *msg, size_t len)
 }
 
 /* The springpot's damper rate from F = c_alpha (eta x2' + sum_i a_i phi_i)
- * (docs/model.md §6), the modes phi as they are. */
-static double springpot_rate(const contact_model *cm, double F)
+ * (docs/model.md §6) with the modes phi. */
+static double springpot_rate(const contact_model *cm, double F, const double *phi)
 {
     const contact_modes *m = &cm->modes;
     double pull = 0.0;
     size_t i;
     for (i = 0; i < m->modes; i++)
-        pull += m->a[i] * m->phi[i];
+        pull += m->a[i] * phi[i];
     return (F / cm->p.c_alpha - pull) / m->eta;
 }
 
-void contact_me_set_states(contact_model *cm, const double *x)
+int contact_me_set_states(contact_model *cm, const double *x)
 {
     contact_state *s = &cm->s;
+    const double x1 = x[CONTACT_ME_X] - x[CONTACT_ME_X2], F = x1 > 0.0 ? spring_force(cm, cm->k_fixed, x1) : 0.0,
+                 rate = springpot(cm) ? springpot_rate(cm, F, x + CONTACT_ME_MODES) : F * cm->inv_c;
     size_t i;
+    if (!isfinite(x1) || !isfinite(F) || !isfinite(rate) || !isfinite(F * rate))
+        return -1;
     s->x2 = x[CONTACT_ME_X2];
-    s->x1 = x[CONTACT_ME_X] - s->x2;
+    s->x1 = x1;
     if (cm->p.scene == CONTACT_SCENE_DROP)
         s->v = x[CONTACT_ME_V]; /* the driven scene's rate is its input (contact_drive) */
     s->E_diss = x[CONTACT_ME_E_DISS];
     for (i = 0; i < cm->modes.modes; i++)
         cm->modes.phi[i] = x[CONTACT_ME_MODES + i];
-    s->F = s->x1 > 0.0 ? spring_force(cm, cm->k_fixed, s->x1) : 0.0;
-    s->x2_rate = springpot(cm) ? springpot_rate(cm, s->F) : s->F * cm->inv_c;
+    s->F = F;
+    s->x2_rate = rate;
+    return 0;
 }
 
 void contact_me_get_states(const contact_model *cm, double *x)

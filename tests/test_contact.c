@@ -699,7 +699,7 @@ static void test_model_exchange_rates_are_the_cosimulations(void)
         contact_rates(&cm, &x1_rate, &v_rate, &F_rate);
         x2_rate = contact_damper_rate(&cm);
         contact_me_get_states(&cm, x);
-        contact_me_set_states(&cm, x);
+        CHECK(contact_me_set_states(&cm, x) == 0, "damper %d: the states taken", damper);
         contact_me_derivatives(&cm, dx);
         CHECK(cm.s.in_contact && fabs(dx[CONTACT_ME_X] - dx[CONTACT_ME_X2] - x1_rate) <= 1e-12 * fabs(cm.s.v),
               "damper %d: x' - x2' = %.17g, contact_rates' x1' %.17g", damper, dx[CONTACT_ME_X] - dx[CONTACT_ME_X2],

@@ -268,9 +268,9 @@ def test_the_discrete_time_methods_are_refused_and_the_instance_stays_usable(ins
 
 
 def test_states_that_overflow_or_are_not_finite_are_errors(instance):
-    """A non-finite state is refused naming it, the states kept; finite
-    states whose rates overflow (a kilometre's indentation) are an error of
-    GetDerivatives, not infinities handed to the host."""
+    """A non-finite state is refused naming it, the states kept; so are
+    finite states whose force would overflow; extreme but finite states
+    whose rates stay finite are taken."""
     i = instance(law=2).start()
     x = i.states()
     bad = x.copy()
@@ -278,11 +278,22 @@ def test_states_that_overflow_or_are_not_finite_are_errors(instance):
     with pytest.raises(Exception):
         i.set_states(bad)
     assert "the state 2 is nan" in i.log[-1] and (i.states() == x).all()
-    x[0] = 1e300
-    i.set_states(x)
+    x[0] = 1e300  # a force of 1e458 N
     with pytest.raises(Exception):
-        i.derivatives()
-    assert "overflows" in i.log[-1]
+        i.set_states(x)
+    assert "beyond double precision" in i.log[-1] and i.states()[0] == 0.0
+    x[0], x[1] = 1e-4, 1e300  # a finite state whose rate -F/m ... and x's rate v: 1e300 is finite
+    i.set_states(x)
+    x[3] = 1e308  # E_diss: finite; its rate F x2' finite; every derivative finite
+    i.set_states(x)
+    assert np.isfinite(i.derivatives()).all()
+    s = instance(law=2, damper=2).start()  # a mode stretched to 1e300 m relaxes at b phi beyond doubles
+    x = s.states()
+    x[4] = 1e300
+    s.set_states(x)
+    with pytest.raises(Exception):
+        s.derivatives()
+    assert "the derivative of the state 4 overflows" in s.log[-1]
 
 
 def test_the_call_sequence_is_enforced(instance):

@@ -762,7 +762,10 @@ fm_status fm_me_set_states(fmu_model *fm, const double *x)
         if (!isfinite(x[i]))
             return report(fm, FM_ERROR, "logStatusError",
                           "SetContinuousStates: the state %lu is %g: it must be finite", (unsigned long)i, x[i]);
-    contact_me_set_states(&fm->model, x);
+    if (contact_me_set_states(&fm->model, x) != 0)
+        return report(fm, FM_ERROR, "logStatusError",
+                      "SetContinuousStates: x = %g m, x2 = %g m and the modes give a force or a damper rate beyond "
+                      "double precision; the states are kept as they were", x[CONTACT_ME_X], x[CONTACT_ME_X2]);
     me_follow_inputs(fm);
     return FM_OK;
 }
