@@ -21,10 +21,17 @@ FMI2, FMI3, PAGE = pathlib.Path("modelDescription.xml"), pathlib.Path("fmi3/mode
     pathlib.Path("docs/variables.md")
 COLUMNS = ("name", "type", "unit", "default", "min", "max", "vr", "index", "variability", "words", "rule",
            "description")
-KINDS = ("input", "parameter", "stop", "option", "output")
+KINDS = ("input", "parameter", "stop", "option", "output", "derivative", "state", "indicator")
+# Model Exchange's kinds: der(name) of an output, a local state of MODES elements, an event indicator.
+EXCHANGE_KINDS = ("derivative", "state", "indicator")
+MODES = int(re.search(r"#define CONTACT_MAX_MODES (\d+)", pathlib.Path(__file__).parent.joinpath(
+    "..", "model", "contact.h").read_text()).group(1))
+DERIVATIVE_OFFSET = 1000  # a STATE row's der(name[i]) is this many value references on (fmu_model.h)
 PLACES = ("model", "fmu", "library", "solver", "package")
 # The initial unknowns that depend on a variable at the start: x = -gap0, v_striker = v - v2.
 INITIAL_DEPENDENCIES = {"x": ("gap0",), "v_striker": ("v", "v2")}
+# Model Exchange's derivatives that depend on a variable at the start: der(x) = v - v2, der(v_striker) = g.
+EXCHANGE_DEPENDENCIES = {"der(x)": ("v", "v2"), "der(v_striker)": ("g",)}
 ARGUMENT = re.compile(r'\s*((?:"[^"\\]*"\s*)+|[^,"]*?)\s*(,|$)')
 
 
@@ -60,8 +67,58 @@ def read_table(path):
 
 
 def fmu_rows(rows):
-    """The FMU's variables in the order of modelDescription.xml."""
-    return sorted((r for r in rows if "fmu" in r["where"]), key=lambda r: int(r["index"]))
+    """The FMU's variables in the order of modelDescription.xml, but Model Exchange's."""
+    return sorted((r for r in rows if "fmu" in r["where"] and r["kind"] not in EXCHANGE_KINDS),
+                  key=lambda r: int(r["index"]))
+
+
+def exchange_variables(rows):
+    """Model Exchange's variables as dicts (name, vr, index, unit, description, start, and
+    derivative: the name of the state whose derivative it is, or None; indicator), in index
+    order: a DERIVATIVE row's der(name), a STATE row's name[1..MODES] and then der(name[i]),
+    an INDICATOR row's name."""
+    found = []
+    for r in rows:
+        if r["kind"] == "indicator":
+            found.append(dict(name=r["name"], vr=r["vr"], index=r["index"], unit=r["unit"],
+                              description=r["description"], start="", derivative=None, indicator=True))
+        if r["kind"] == "derivative":
+            found.append(dict(name=f"der({r['name']})", vr=r["vr"], index=r["index"], unit=r["unit"],
+                              description=r["description"], start="", derivative=r["name"]))
+        elif r["kind"] == "state":
+            for i in range(MODES):
+                found.append(dict(name=f"{r['name']}[{i + 1}]", vr=str(int(r["vr"]) + i),
+                                  index=str(int(r["index"]) + i), unit=r["unit"], start=r["default"],
+                                  description=r["description"] if i == 0 else
+                                  f"mode {i + 1} of {r['name']} (see {r['name']}[1])", derivative=None))
+            for i in range(MODES):
+                found.append(dict(name=f"der({r['name']}[{i + 1}])", vr=str(int(r["vr"]) + DERIVATIVE_OFFSET + i),
+                                  index=str(int(r["index"]) + MODES + i), unit=f"{r['unit']}/s",
+                                  description=f"the rate of {r['name']}[{i + 1}]", start="",
+                                  derivative=f"{r['name']}[{i + 1}]"))
+    return sorted(found, key=lambda v: int(v["index"]))
+
+
+def state_index(variables, fmu, name):
+    """The FMI 2.0 index of the state `name`: an output's, or a STATE row's element."""
+    by_name = {r["name"]: r["index"] for r in fmu}
+    by_name.update({v["name"]: v["index"] for v in variables})
+    return by_name[name]
+
+
+def fmi2_exchange_variable(v, fmu, variables):
+    if v.get("indicator"):
+        real, initial = f'<Real unit="{v["unit"]}"/>', ""
+    elif v["derivative"]:
+        real = f'<Real unit="{v["unit"]}" derivative="{state_index(variables, fmu, v["derivative"])}"/>'
+        initial = ""
+    else:
+        real = f'<Real unit="{v["unit"]}" start="{v["start"]}"/>'
+        initial = ' initial="exact"'
+    return (f'    <!-- {v["index"]} --><ScalarVariable name="{v["name"]}" valueReference="{v["vr"]}" '
+            f'causality="local" variability="continuous"{initial}\n'
+            f'      description="{html.escape(v["description"], quote=False)}">\n'
+            f'      {real}</ScalarVariable>')
 
 
 def attributes(row, names):
@@ -90,18 +147,32 @@ def dependencies(row, by_name, key):
     return " ".join(by_name[d][key] for d in INITIAL_DEPENDENCIES.get(row["name"], ()))
 
 
+def exchange_dependencies(variable, by_name, key):
+    return " ".join(by_name[d][key] for d in EXCHANGE_DEPENDENCIES.get(variable["name"], ()))
+
+
 def fmi2_section(rows):
     """From <ModelVariables> to </ModelStructure> of modelDescription.xml."""
     fmu = fmu_rows(rows)
     by_name = {r["name"]: r for r in fmu}
     outputs = [r for r in fmu if r["kind"] == "output"]
-    lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu] + ["  </ModelVariables>", "",
-                                                                           "  <ModelStructure>", "    <Outputs>",
-             "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
+    exchange = exchange_variables(rows)
+    derivatives = [v for v in exchange if v["derivative"]]
+    lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu]
+    lines += [fmi2_exchange_variable(v, fmu, exchange) for v in exchange]
+    lines += ["  </ModelVariables>", "", "  <ModelStructure>", "    <Outputs>",
+              "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies=""/>' for r in outputs]
-    lines += ["    </Outputs>", "    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
+    lines += ["    </Outputs>"]
+    if derivatives:
+        lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md); at the "
+                  "start der(x) = v - v2 (1, 36), der(v_striker) = g (11), the rest 0 -->"]
+        lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives] + ["    </Derivatives>"]
+    lines += ["    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies="{dependencies(r, by_name, "index")}"/>'
               for r in outputs]
+    lines += [f'      <Unknown index="{v["index"]}" dependencies="{exchange_dependencies(v, by_name, "index")}"/>'
+              for v in derivatives]
     return "\n".join(lines + ["    </InitialUnknowns>", "  </ModelStructure>"])
 
 
@@ -117,21 +188,42 @@ def fmi3_variable(row):
             f'      description="{html.escape(row["description"], quote=False)}"/>')
 
 
+def fmi3_exchange_variable(v, fmu, variables):
+    vr = {r["name"]: r["vr"] for r in fmu}
+    vr.update({w["name"]: w["vr"] for w in variables})
+    extra = f' derivative="{vr[v["derivative"]]}"' if v["derivative"] else ""
+    if not v["derivative"] and not v.get("indicator"):
+        extra = f' initial="exact" start="{v["start"]}"'
+    return (f'    <Float64 name="{v["name"]}" valueReference="{v["vr"]}" causality="local" variability="continuous" '
+            f'unit="{v["unit"]}"{extra}\n      description="{html.escape(v["description"], quote=False)}"/>')
+
+
 def fmi3_section(rows):
     """From <ModelVariables> to </ModelStructure> of fmi3/modelDescription.xml."""
     fmu = fmu_rows(rows)
     by_name = {r["name"]: r for r in fmu}
     outputs = [r for r in fmu if r["kind"] == "output"]
+    exchange = exchange_variables(rows)
+    derivatives = [v for v in exchange if v["derivative"]]
     lines = ["  <ModelVariables>",
              '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous" unit="s"',
              '      description="simulation time"/>']
-    lines += [fmi3_variable(r) for r in fmu] + ["  </ModelVariables>", "", "  <ModelStructure>",
-                                                "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
-                                                "         mode): no direct feedthrough from the inputs -->"]
+    lines += [fmi3_variable(r) for r in fmu] + [fmi3_exchange_variable(v, fmu, exchange) for v in exchange]
+    lines += ["  </ModelVariables>", "", "  <ModelStructure>",
+              "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
+              "         mode): no direct feedthrough from the inputs -->"]
     lines += [f'    <Output valueReference="{r["vr"]}"/>' for r in outputs]
+    if derivatives:
+        lines += ["    <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
+        lines += [f'    <ContinuousStateDerivative valueReference="{v["vr"]}"/>' for v in derivatives]
     lines += [f"    <!-- {initial_comment(by_name, 'vr')} -->"]
     lines += [f'    <InitialUnknown valueReference="{r["vr"]}" dependencies="{dependencies(r, by_name, "vr")}"/>'
               for r in outputs]
+    if derivatives:
+        lines += ["    <!-- at the start der(x) = v - v2 (1, 36), der(v_striker) = g (11), the rest 0 -->"]
+    lines += [f'    <InitialUnknown valueReference="{v["vr"]}" '
+              f'dependencies="{exchange_dependencies(v, by_name, "vr")}"/>' for v in derivatives]
+    lines += [f'    <EventIndicator valueReference="{v["vr"]}"/>' for v in exchange if v.get("indicator")]
     return "\n".join(lines + ["  </ModelStructure>"])
 
 

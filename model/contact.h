@@ -509,4 +509,56 @@ double contact_semi_integral_per_force(const contact_model *cm); /* 1/(Gamma(n+1
  * the extrapolated G1 law replaces that ratio by g1_line_ratio_extrapolated. */
 double contact_spring_stiffness(const contact_model *cm, long n_steps);
 
+/* Model Exchange (rates.c, docs/model_exchange.md): the model as an ODE
+ * that a host's solver integrates, for the closed-form force (law 2) with
+ * the dashpot or the compressed springpot. The states, in this order: the
+ * total indentation x = x1 + x2 (its rate v), the approach speed v (its
+ * rate g + a - F/m in the drop test; in the driven scene unused, rate 0:
+ * the rate of x is the input, contact_drive), the damper's travel x2, the
+ * work on the damper E_diss, then CONTACT_MAX_MODES slots of the
+ * springpot's modes (those beyond its kernel's, and all of a dashpot's,
+ * stay 0 at rate 0). */
+enum { CONTACT_ME_X, CONTACT_ME_V, CONTACT_ME_X2, CONTACT_ME_E_DISS, CONTACT_ME_MODES };
+#define CONTACT_ME_STATES (CONTACT_ME_MODES + CONTACT_MAX_MODES)
+
+/* Event indicators: x1 (onset as it rises through 0, separation as it
+ * falls), and in contact the indentation's rate x1' (the force's peak as it
+ * falls through 0). */
+#define CONTACT_ME_INDICATORS 2
+
+/* Whether these parameters run in Model Exchange: law 2, the compressed
+ * memory, scheme 1. 0, or -1 and a message naming the parameter, its value
+ * and what to take instead. */
+int contact_me_check(const contact_params *p, char *msg, size_t len);
+
+/* The states into the model (the force and the damper's rate follow from
+ * them: 0, or -1 and the model as it was where those or the damper's power
+ * would not be finite) and out of it, CONTACT_ME_STATES values each. */
+int contact_me_set_states(contact_model *cm, const double *x);
+void contact_me_get_states(const contact_model *cm, double *x);
+
+/* The states' rates at the model's state. */
+void contact_me_derivatives(const contact_model *cm, double *dx);
+
+/* The derivatives' change for a change dx of the states and, in the driven
+ * scene, dv of the input approach speed v - v2 (the Jacobian times them, in
+ * closed form): CONTACT_ME_STATES values each. */
+void contact_me_directional(const contact_model *cm, const double *dx, double dv, double *df);
+
+/* The states' nominal values for a striker of mass m (0: the rate
+ * prescribed) meeting the specimen at the approach speed v0: the impact's
+ * indentation scale for the lengths, the speed, the kinetic energy. */
+void contact_me_nominals(const contact_model *cm, double v0, double m, double *nominal);
+
+/* The CONTACT_ME_INDICATORS event indicators at the model's state. */
+void contact_me_indicators(const contact_model *cm, double *z);
+
+/* At an event at the model's time: the contact begun or ended where the
+ * state says so (the impact's figures eps, t_contact at its end), the peak
+ * forces taken. The event's bit (enum contact_event), or 0. */
+int contact_me_event(contact_model *cm);
+
+/* At a state the host accepted (and at an event): the peak forces taken. */
+void contact_me_accept(contact_model *cm);
+
 #endif

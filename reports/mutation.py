@@ -322,8 +322,8 @@ MUTANTS = [
     # ------------------------------------------------------------ call sequence
     mutant("seq-set-after-terminate", "call sequence", "fmi2Set* allowed in the terminated state",
            STRUCTURAL + "; test_fmi2 'after terminate'",
-           (STATE, "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE)",
-            "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)")),
+           (STATE, "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | RUNNING)",
+            "#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | RUNNING | TERMINATED)")),
     mutant("seq-step-in-initialization", "call sequence", "fmi2DoStep allowed in initialization mode",
            STRUCTURAL + "; test_fmi2, test_fmu_bad_input::test_wrong_call_order_is_an_error_not_a_crash",
            (STATE, 'REQUIRE(STEP_COMPLETE, "fmi2DoStep");', 'REQUIRE(STEP_COMPLETE | INITIALIZATION_MODE, "fmi2DoStep");')),

@@ -23,11 +23,11 @@ from fraccontact.output import make_folder
 from . import BAR, source_tree
 
 ROOT = source_tree()
-FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmu_instance.c",
-               "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "model/g1.c"] + [
+FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmi2_me.c", "fmu_src/binding/fmu_model.c",
+               "fmu_src/glue/fmu_instance.c", "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "model/g1.c"] + [
     f"model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
                                            "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central",
-                                           "passivity")]
+                                           "passivity", "rates")]
 
 
 def sh(*args, **kw):

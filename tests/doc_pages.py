@@ -9,7 +9,7 @@ import re
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 GUIDES = ("README.md", "coupling.md", "fmi3.md", "ssp.md", "python.md", "solver.md", "fitting.md", "sweeps.md",
-          "scenes.md", "numerics.md", "springpot.md", "variables.md")
+          "scenes.md", "numerics.md", "springpot.md", "variables.md", "model_exchange.md")
 PAGES = {"README.md": ROOT / "README.md", **{f"docs/{name}": ROOT / "docs" / name for name in GUIDES}}
 
 

@@ -273,7 +273,7 @@ static void refused(fmi3Instance x, program *p)
     case 20: s = fmi3SetFloat64(x, two, 2, NULL, 2); break;      /* NULL arrays */
     case 21: s = fmi3GetInt32(x, NULL, 1, &n, 1); break;
     case 22: s = fmi3SetFloat64(x, (const fmi3ValueReference[]){0}, 1, r, 1); break; /* time */
-    default: s = fmi3InstantiateModelExchange("me", FMU_GUID, NULL, fmi3False, fmi3False, NULL, logger) ? fmi3OK
+    default: s = fmi3InstantiateModelExchange("me", "{wrong}", NULL, fmi3False, fmi3False, NULL, logger) ? fmi3OK
                                                                                                         : fmi3Error;
     }
     require(checked(s) == fmi3Error, "a call that must be refused was not");

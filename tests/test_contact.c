@@ -655,6 +655,63 @@ static void test_radau_same_bits_at_every_vector_width(void)
     }
 }
 
+/* Model Exchange (rates.c) takes the closed-form force, the compressed
+ * memory and scheme 1, and refuses the rest naming the parameter. */
+static void test_model_exchange_takes_the_continuous_methods(void)
+{
+    contact_params p;
+    char msg[512];
+    contact_default_params(&p); /* law 1, the G1 history sum */
+    CHECK(contact_me_check(&p, msg, sizeof msg) != 0 && strstr(msg, "law = 1") && strstr(msg, "co-simulation"),
+          "law 1: %s", msg);
+    p.law = CONTACT_LAW_HERTZ;
+    CHECK(contact_me_check(&p, msg, sizeof msg) == 0, "law 2 with the dashpot runs");
+    p.scheme = CONTACT_SCHEME_CENTRAL;
+    CHECK(contact_me_check(&p, msg, sizeof msg) != 0 && strstr(msg, "scheme = 2"), "the central scheme: %s", msg);
+    p.scheme = CONTACT_SCHEME_SDIRK2;
+    p.damper = CONTACT_DAMPER_SPRINGPOT;
+    p.memory = CONTACT_MEMORY_G1;
+    CHECK(contact_me_check(&p, msg, sizeof msg) != 0 && strstr(msg, "memory = 1"), "the full memory: %s", msg);
+    p.memory = CONTACT_MEMORY_COMPRESSED;
+    CHECK(contact_me_check(&p, msg, sizeof msg) == 0, "the compressed springpot runs");
+}
+
+/* Model Exchange's rates at states the co-simulation's steps reach in
+ * contact: x' - x2' is contact_rates's x1' and v' its v'; the springpot's
+ * x2' from its modes is the rate of SDIRK2's last stage, which is the
+ * step's end (the method is stiffly accurate: that stage's modes are the
+ * step's new modes), to rounding. */
+static void test_model_exchange_rates_are_the_cosimulations(void)
+{
+    int damper;
+    for (damper = CONTACT_DAMPER_DASHPOT; damper <= CONTACT_DAMPER_SPRINGPOT; damper++) {
+        contact_params p;
+        contact_model cm;
+        double v0, m, x[CONTACT_ME_STATES], dx[CONTACT_ME_STATES], x1_rate, v_rate, F_rate, x2_rate;
+        int step;
+        contact_default_params(&p);
+        contact_default_striker(&v0, &m);
+        p.law = CONTACT_LAW_HERTZ;
+        p.damper = damper;
+        contact_start(&cm, &p, v0, m);
+        for (step = 0; step < 3000; step++)
+            contact_advance(&cm, 1e-7); /* into the contact: 0.3 ms, before the peak */
+        contact_rates(&cm, &x1_rate, &v_rate, &F_rate);
+        x2_rate = contact_damper_rate(&cm);
+        contact_me_get_states(&cm, x);
+        CHECK(contact_me_set_states(&cm, x) == 0, "damper %d: the states taken", damper);
+        contact_me_derivatives(&cm, dx);
+        CHECK(cm.s.in_contact && fabs(dx[CONTACT_ME_X] - dx[CONTACT_ME_X2] - x1_rate) <= 1e-12 * fabs(cm.s.v),
+              "damper %d: x' - x2' = %.17g, contact_rates' x1' %.17g", damper, dx[CONTACT_ME_X] - dx[CONTACT_ME_X2],
+              x1_rate);
+        CHECK(fabs(dx[CONTACT_ME_V] - v_rate) <= 1e-13 * fabs(v_rate), "damper %d: v' = %.17g, contact_rates' %.17g",
+              damper, dx[CONTACT_ME_V], v_rate);
+        CHECK(fabs(dx[CONTACT_ME_X2] - x2_rate) <= 1e-12 * fabs(x2_rate), "damper %d: x2' = %.17g, the step's %.17g",
+              damper, dx[CONTACT_ME_X2], x2_rate);
+        contact_release(&cm);
+    }
+}
+
 int main(void)
 {
     test_hertz_constant();
@@ -673,6 +730,8 @@ int main(void)
     test_a_start_on_any_memory_runs_as_on_zeros();
     test_radau_same_bits_at_every_vector_width();
     test_kernels_above_the_floor_fit();
+    test_model_exchange_takes_the_continuous_methods();
+    test_model_exchange_rates_are_the_cosimulations();
     printf("test_contact: %d known findings (docs/stability.md)\n", known_seen);
     return check_summary("test_contact");
 }

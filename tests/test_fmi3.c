@@ -261,8 +261,8 @@ static void test_instantiate(void)
     CHECK(c == NULL && strstr(rec.message, "nRequiredIntermediateVariables = 1"),
           "required intermediate variables are refused: %s", rec.message);
     c = fmi3InstantiateModelExchange("x", FMU_GUID, NULL, fmi3False, fmi3False, &rec, logger);
-    CHECK(c == NULL && strstr(rec.message, "fmi3InstantiateModelExchange") && strstr(rec.message, "co-simulation"),
-          "model exchange is refused: %s", rec.message);
+    CHECK(c != NULL, "model exchange is served beside co-simulation: %s", rec.message);
+    fmi3FreeInstance(c);
     c = fmi3InstantiateScheduledExecution("x", FMU_GUID, NULL, fmi3False, fmi3False, &rec, logger, NULL, NULL, NULL);
     CHECK(c == NULL && strstr(rec.message, "fmi3InstantiateScheduledExecution"),
           "scheduled execution is refused: %s", rec.message);

@@ -29,9 +29,12 @@ def perturbed(v):
 
 
 def test_outputs_and_initial_unknowns_are_every_output(model_description):
+    """... and the initial unknowns Model Exchange's state derivatives too."""
     outputs = {v.name for v in model_description.modelVariables if v.causality == "output"}
+    derivatives = {v.name for v in model_description.modelVariables if v.derivative is not None}
     _, out_deps, init_deps = structure(model_description)
-    assert set(out_deps) == outputs and set(init_deps) == outputs
+    assert set(out_deps) == outputs and set(init_deps) == outputs | derivatives
+    assert {u.variable.name for u in model_description.derivatives} == derivatives
 
 
 def test_initial_unknowns_depend_on_exactly_the_declared_knowns(slave, model_description):

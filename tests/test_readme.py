@@ -151,8 +151,10 @@ def model_variables():
 
 
 def test_every_variable_is_in_the_readme_table():
+    """... an array's elements (Model Exchange's modes phi[1], der(phi[1]), ...) as its row name[i]."""
     table = variable_table()
-    missing = [v.get("name") for v in model_variables() if v.get("name") not in table]
+    missing = [v.get("name") for v in model_variables()
+               if v.get("name") not in table and re.sub(r"\[\d+\]", "[i]", v.get("name")) not in table]
     assert not missing, f"not in docs/variables.md's table of what each variable does: {missing}"
 
 

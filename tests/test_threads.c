@@ -13,6 +13,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <dlfcn.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,6 +80,15 @@ static struct {
     fmi2ExitInitializationModeTYPE *exit;
     fmi2DoStepTYPE *step;
     fmi2FreeInstanceTYPE *free;
+    /* Model Exchange */
+    fmi2NewDiscreteStatesTYPE *new_discrete_states;
+    fmi2EnterContinuousTimeModeTYPE *enter_continuous;
+    fmi2EnterEventModeTYPE *enter_event;
+    fmi2SetTimeTYPE *set_time;
+    fmi2GetContinuousStatesTYPE *get_states;
+    fmi2SetContinuousStatesTYPE *set_states;
+    fmi2GetDerivativesTYPE *get_derivatives;
+    fmi2GetEventIndicatorsTYPE *get_indicators;
 } fmi2;
 
 static struct {
@@ -119,6 +129,14 @@ static void load(const char *fmi2_path, const char *fmi3_path, const char *libra
     *(void **)&fmi2.exit = symbol(a, "fmi2ExitInitializationMode");
     *(void **)&fmi2.step = symbol(a, "fmi2DoStep");
     *(void **)&fmi2.free = symbol(a, "fmi2FreeInstance");
+    *(void **)&fmi2.new_discrete_states = symbol(a, "fmi2NewDiscreteStates");
+    *(void **)&fmi2.enter_continuous = symbol(a, "fmi2EnterContinuousTimeMode");
+    *(void **)&fmi2.enter_event = symbol(a, "fmi2EnterEventMode");
+    *(void **)&fmi2.set_time = symbol(a, "fmi2SetTime");
+    *(void **)&fmi2.get_states = symbol(a, "fmi2GetContinuousStates");
+    *(void **)&fmi2.set_states = symbol(a, "fmi2SetContinuousStates");
+    *(void **)&fmi2.get_derivatives = symbol(a, "fmi2GetDerivatives");
+    *(void **)&fmi2.get_indicators = symbol(a, "fmi2GetEventIndicators");
     *(void **)&fmi3.instantiate = symbol(b, "fmi3InstantiateCoSimulation");
     *(void **)&fmi3.set_int32 = symbol(b, "fmi3SetInt32");
     *(void **)&fmi3.set_float64 = symbol(b, "fmi3SetFloat64");
@@ -173,6 +191,56 @@ static void run_fmi2(run *r)
         fmi2.free(x);
 }
 
+/* Model Exchange through FMI 2.0 (the configurations of law 2 with the
+ * dashpot): the host's solver here explicit Euler steps of H / ME_STEPS,
+ * an event where an indicator changes sign. */
+enum { ME_STATES = 164, ME_INDICATORS = 2, ME_STEPS = 200 };
+
+static int me_step(fmi2Component x, double t, double *states, double *z)
+{
+    double rates[ME_STATES], next[ME_INDICATORS];
+    fmi2EventInfo info;
+    int i, event = 0;
+    if (fmi2.get_derivatives(x, rates, ME_STATES) != fmi2OK)
+        return -1;
+    for (i = 0; i < ME_STATES; i++)
+        states[i] += H / ME_STEPS * rates[i];
+    if (fmi2.set_time(x, t) != fmi2OK || fmi2.set_states(x, states, ME_STATES) != fmi2OK
+        || fmi2.get_indicators(x, next, ME_INDICATORS) != fmi2OK)
+        return -1;
+    for (i = 0; i < ME_INDICATORS; i++)
+        event |= (next[i] > 0.0) != (z[i] > 0.0);
+    if (event && (fmi2.enter_event(x) != fmi2OK || fmi2.new_discrete_states(x, &info) != fmi2OK
+                  || fmi2.enter_continuous(x) != fmi2OK || fmi2.get_indicators(x, next, ME_INDICATORS) != fmi2OK))
+        return -1;
+    memcpy(z, next, sizeof next);
+    return 0;
+}
+
+static void run_fmi2_me(run *r)
+{
+    const configuration *c = &configurations[r->config];
+    const fmi2CallbackFunctions callbacks = {logger2, calloc, free, NULL, NULL};
+    const fmi2Integer integer[3] = {c->law, c->damper, c->memory};
+    fmi2Real real[3];
+    const fmi2ValueReference *real_vr = real_parameters(r, real);
+    fmi2Component x = fmi2.instantiate("threads", fmi2ModelExchange, fmi2_guid, "", &callbacks, fmi2False, fmi2False);
+    double states[ME_STATES], z[ME_INDICATORS];
+    fmi2EventInfo info;
+    int i, j;
+    r->failed = !x || fmi2.set_integer(x, integer_vr, 3, integer) != fmi2OK || fmi2.set_real(x, real_vr, 3, real) != fmi2OK
+                || fmi2.enter(x) != fmi2OK || fmi2.exit(x) != fmi2OK || fmi2.new_discrete_states(x, &info) != fmi2OK
+                || fmi2.enter_continuous(x) != fmi2OK || fmi2.get_states(x, states, ME_STATES) != fmi2OK
+                || fmi2.get_indicators(x, z, ME_INDICATORS) != fmi2OK;
+    for (i = 0; i < STEPS && !r->failed; i++) {
+        for (j = 1; j <= ME_STEPS && !r->failed; j++)
+            r->failed = me_step(x, i * H + j * (H / ME_STEPS), states, z) != 0;
+        r->failed = r->failed || fmi2.get_real(x, output_vr, OUTPUTS, r->outputs[i]) != fmi2OK;
+    }
+    if (x)
+        fmi2.free(x);
+}
+
 static void run_fmi3(run *r)
 {
     const configuration *c = &configurations[r->config];
@@ -217,21 +285,30 @@ static void perform(run *r)
     memset(r->outcomes, 0, sizeof r->outcomes);
     if (r->fmi == 2)
         run_fmi2(r);
+    else if (r->fmi == 4)
+        run_fmi2_me(r);
     else if (r->fmi == 3)
         run_fmi3(r);
     else
         run_batch(r);
 }
 
-/* Every FMU configuration in both versions, and batches, in two variants:
+/* Every FMU configuration in both versions, batches, and Model Exchange
+ * (fmi = 4) of the two configurations from ME_FIRST on, in two variants:
  * RUNS runs, shared out among the threads. */
-enum { RUNS = 2 * (2 * CONFIGURATIONS + 1) };
+enum { ME_FIRST = 1, ME_CONFIGURATIONS = 2, PER_VARIANT = 2 * CONFIGURATIONS + 1 + ME_CONFIGURATIONS,
+       RUNS = 2 * PER_VARIANT };
 static run alone[RUNS], threaded[RUNS];
 
 static void describe(run *r, int k)
 {
-    r->variant = k / (2 * CONFIGURATIONS + 1);
-    k %= 2 * CONFIGURATIONS + 1;
+    r->variant = k / PER_VARIANT;
+    k %= PER_VARIANT;
+    if (k > 2 * CONFIGURATIONS) {
+        r->fmi = 4;
+        r->config = ME_FIRST + k - 2 * CONFIGURATIONS - 1;
+        return;
+    }
     r->fmi = k == 2 * CONFIGURATIONS ? 0 : 2 + k / CONFIGURATIONS;
     r->config = k % CONFIGURATIONS;
 }
@@ -265,12 +342,19 @@ int main(int argc, char **argv)
         pthread_join(threads[k], NULL);
     for (k = 0; k < RUNS; k++) {
         const run *a = &alone[k], *t = &threaded[k];
-        const char *via = a->fmi == 2 ? "FMI 2.0" : a->fmi == 3 ? "FMI 3.0" : "the library",
+        const char *via = a->fmi == 2 ? "FMI 2.0" : a->fmi == 3 ? "FMI 3.0" : a->fmi == 4 ? "FMI 2.0 Model Exchange"
+                                                                                        : "the library",
                    *what = a->fmi ? configurations[a->config].name : "a batch of every configuration";
         CHECK(!a->failed && !t->failed, "%s, %s, variant %d: a run failed", via, what, a->variant);
         CHECK(memcmp(a->outputs, t->outputs, sizeof a->outputs) == 0
                   && memcmp(a->outcomes, t->outcomes, sizeof a->outcomes) == 0,
               "%s, %s, variant %d: in a thread, results not those of the run alone", via, what, a->variant);
+        if (a->fmi == 4) { /* the impact ended, eps within Euler's first-order error (h = 1e-7 s) of co-simulation's */
+            const run *cs = &alone[a->variant * PER_VARIANT + a->config];
+            const double eps = a->outputs[STEPS - 1][OUTPUTS - 1], cs_eps = cs->outputs[STEPS - 1][OUTPUTS - 1];
+            CHECK(eps > 0.0 && fabs(eps / cs_eps - 1.0) < 2e-3, "%s, %s, variant %d: eps %.9g, co-simulation's %.9g",
+                  via, what, a->variant, eps, cs_eps);
+        }
     }
     return check_summary("test_threads");
 }

@@ -1,5 +1,6 @@
 #include "fmu_model.h"
 
+#include "fmu_me.h"
 #include "fmu_vars.h"
 #include "serial.h"
 
@@ -62,6 +63,8 @@ struct fmu_model {
     int held_contact;     /* their values from before it until fm_update_discrete */
     int coupling_warned;  /* the master was seen feeding the other coupling's force, and told */
     double held_eps;
+    int model_exchange;   /* serves a Model Exchange instance (fm_me_instantiated) */
+    double me_speed, me_mass; /* Model Exchange: the approach speed and mass its nominal values are of */
     contact_model model;
     prediction next;
     fmu_reporter log;
@@ -258,9 +261,14 @@ static const fmu_variable *nonfinite_output(const fmu_model *fm)
     return NULL;
 }
 
+static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value);
+
 fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
 {
-    const fmu_variable *var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
+    const fmu_variable *var;
+    if (model_exchange_variable(fm, vr, value))
+        return FM_OK;
+    var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
     if (!var)
         return FM_ERROR;
     preview_start(fm);
@@ -701,6 +709,201 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     return FM_OK;
 }
 
+/* ------------------------------------------------------- Model Exchange */
+
+const size_t fm_me_states = CONTACT_ME_STATES, fm_me_indicators = CONTACT_ME_INDICATORS;
+
+/* The driven scene's indentation rate is its input, read wherever the
+ * model's rates are. */
+static void me_follow_inputs(fmu_model *fm)
+{
+    preview_start(fm); /* before initialization ends: the state it would start from */
+    if (fm->params.scene == CONTACT_SCENE_DRIVEN)
+        fm->model.s.v = approach(&fm->in);
+}
+
+void fm_me_instantiated(fmu_model *fm)
+{
+    fm->model_exchange = 1;
+}
+
+fm_status fm_me_start(fmu_model *fm, double t0, double t_stop)
+{
+    char why[512];
+    fm_status status;
+    if (contact_me_check(&fm->params, why, sizeof why) != 0)
+        return report(fm, FM_ERROR, "logStatusError", "%s", why);
+    status = fm_start(fm, t0, t_stop);
+    if (status == FM_ERROR)
+        return status;
+    /* the host's solver moves the bodies: no proxy striker in the driven scene */
+    if (fm->params.scene == CONTACT_SCENE_DRIVEN)
+        contact_drive(&fm->model, approach(&fm->in), 0.0, 0.0);
+    fm->me_speed = approach(&fm->in);
+    fm->me_mass = fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0;
+    if (status == FM_OK && fm->params.scene == CONTACT_SCENE_DRIVEN
+        && (fm->in.m != 0.0 || other_accel(&fm->in) != 0.0 || fm->coupling != COUPLING_GAUSS_SEIDEL))
+        return report(fm, FM_WARNING, "logStatusWarning",
+                      "m = %g, a = %g, a2 = %g and coupling = %d have no effect in Model Exchange's driven scene "
+                      "(scene = 2): the host moves the bodies, and the indentation's rate is v - v2 as given",
+                      fm->in.m, fm->in.a, fm->in.a2, fm->coupling);
+    return status;
+}
+
+void fm_me_set_time(fmu_model *fm, double t)
+{
+    fm->model.s.t = t;
+}
+
+fm_status fm_me_set_states(fmu_model *fm, const double *x)
+{
+    size_t i;
+    for (i = 0; i < CONTACT_ME_STATES; i++)
+        if (!isfinite(x[i]))
+            return report(fm, FM_ERROR, "logStatusError",
+                          "SetContinuousStates: the state %lu is %g: it must be finite", (unsigned long)i, x[i]);
+    if (contact_me_set_states(&fm->model, x) != 0)
+        return report(fm, FM_ERROR, "logStatusError",
+                      "SetContinuousStates: x = %g m, x2 = %g m and the modes give a force or a damper rate beyond "
+                      "double precision; the states are kept as they were", x[CONTACT_ME_X], x[CONTACT_ME_X2]);
+    me_follow_inputs(fm);
+    return FM_OK;
+}
+
+void fm_me_get_states(fmu_model *fm, double *x)
+{
+    me_follow_inputs(fm);
+    contact_me_get_states(&fm->model, x);
+}
+
+fm_status fm_me_derivatives(fmu_model *fm, double *dx)
+{
+    size_t i;
+    me_follow_inputs(fm);
+    contact_me_derivatives(&fm->model, dx);
+    /* extreme but finite states (an indentation of metres on a steel
+     * spring) can overflow a rate */
+    for (i = 0; i < CONTACT_ME_STATES; i++)
+        if (!isfinite(dx[i]))
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDerivatives: the derivative of the state %lu overflows (%g) at x = %g m, x2 = %g m",
+                          (unsigned long)i, dx[i], contact_total_indentation(&fm->model), fm->model.s.x2);
+    return FM_OK;
+}
+
+void fm_me_nominals(fmu_model *fm, double *nominal)
+{
+    me_follow_inputs(fm);
+    if (!fm->started) /* before the start: of the inputs so far */
+        contact_me_nominals(&fm->model, approach(&fm->in),
+                            fm->params.scene == CONTACT_SCENE_DROP ? proxy_mass(&fm->in) : 0.0, nominal);
+    else
+        contact_me_nominals(&fm->model, fm->me_speed, fm->me_mass, nominal);
+}
+
+void fm_me_event_indicators(fmu_model *fm, double *z)
+{
+    me_follow_inputs(fm);
+    contact_me_indicators(&fm->model, z);
+}
+
+void fm_me_event(fmu_model *fm)
+{
+    const contact_state before = fm->model.s;
+    me_follow_inputs(fm);
+    contact_me_event(&fm->model);
+    report_events(fm, &before);
+}
+
+void fm_me_step_completed(fmu_model *fm)
+{
+    contact_me_accept(&fm->model);
+}
+
+/* The state of value reference vr (its place among the states), or -1. */
+static long me_state_of(unsigned vr)
+{
+    switch (vr) {
+    case VR_x: return CONTACT_ME_X;
+    case VR_v_striker: return CONTACT_ME_V;
+    case VR_x2: return CONTACT_ME_X2;
+    case VR_E_diss: return CONTACT_ME_E_DISS;
+    default: return vr >= VR_phi && vr - VR_phi < CONTACT_MAX_MODES ? CONTACT_ME_MODES + (long)(vr - VR_phi) : -1;
+    }
+}
+
+/* The derivative of value reference vr (the place of its state), or -1. */
+static long me_derivative_of(unsigned vr)
+{
+    switch (vr) {
+    case VR_der_x: return CONTACT_ME_X;
+    case VR_der_v_striker: return CONTACT_ME_V;
+    case VR_der_x2: return CONTACT_ME_X2;
+    case VR_der_E_diss: return CONTACT_ME_E_DISS;
+    default: return vr >= VR_phi + VR_DERIVATIVE_OFFSET ? me_state_of(vr - VR_DERIVATIVE_OFFSET) : -1;
+    }
+}
+
+fm_status fm_me_directional(fmu_model *fm, const unsigned *unknowns, size_t n_unknowns, const unsigned *knowns,
+                            size_t n_knowns, const double *seed, double *sensitivity)
+{
+    double dx[CONTACT_ME_STATES] = {0.0}, df[CONTACT_ME_STATES], dv = 0.0;
+    size_t i;
+    me_follow_inputs(fm);
+    for (i = 0; i < n_knowns; i++) {
+        const long state = me_state_of(knowns[i]);
+        if (state >= 0)
+            dx[state] += seed[i];
+        else if (knowns[i] == VR_v || knowns[i] == VR_v2) /* the driven scene's rate v - v2 */
+            dv += knowns[i] == VR_v ? seed[i] : -seed[i];
+        else
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDirectionalDerivative: value reference %u is not a continuous state or the input v "
+                          "or v2: the derivatives are differentiated with respect to those", knowns[i]);
+    }
+    for (i = 0; i < n_unknowns; i++)
+        if (me_derivative_of(unknowns[i]) < 0)
+            return report(fm, FM_ERROR, "logStatusError",
+                          "GetDirectionalDerivative: value reference %u is not a state derivative (der(x), "
+                          "der(v_striker), der(x2), der(E_diss), der(phi[i]))", unknowns[i]);
+    contact_me_directional(&fm->model, dx, dv, df);
+    for (i = 0; i < n_unknowns; i++)
+        sensitivity[i] = df[me_derivative_of(unknowns[i])];
+    return FM_OK;
+}
+
+/* The derivatives and the modes by value reference (parameters.def's
+ * DERIVATIVE and STATE rows) at the model's state: 1 and *value, or 0 for
+ * another reference. */
+static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value)
+{
+    double x[CONTACT_ME_STATES];
+    int derivative = vr >= VR_phi + VR_DERIVATIVE_OFFSET;
+    unsigned mode = vr - (derivative ? VR_phi + VR_DERIVATIVE_OFFSET : VR_phi);
+    if (!(vr >= VR_der_x && vr <= VR_event_x1_rate) && !(vr >= VR_phi && mode < CONTACT_MAX_MODES))
+        return 0;
+    preview_start(fm); /* and nothing else changes the model: a co-simulation master reads these too */
+    if (vr == VR_event_x1 || vr == VR_event_x1_rate) {
+        contact_me_indicators(&fm->model, x);
+        *value = x[vr - VR_event_x1];
+        return 1;
+    }
+    if (vr >= VR_phi && !derivative) {
+        contact_me_get_states(&fm->model, x);
+        *value = x[CONTACT_ME_MODES + mode];
+        return 1;
+    }
+    contact_me_derivatives(&fm->model, x);
+    switch (vr) {
+    case VR_der_x: *value = x[CONTACT_ME_X]; break;
+    case VR_der_v_striker: *value = x[CONTACT_ME_V]; break;
+    case VR_der_x2: *value = x[CONTACT_ME_X2]; break;
+    case VR_der_E_diss: *value = x[CONTACT_ME_E_DISS]; break;
+    default: *value = x[CONTACT_ME_MODES + mode]; break;
+    }
+    return 1;
+}
+
 /* ------------------------------------------------------------ FMU state */
 
 /* Every value a simulation depends on, field by field: a raw copy of the
@@ -813,7 +1016,8 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
         || (trial.held != 0 && trial.held != 1) || (trial.held_contact != 0 && trial.held_contact != 1)
-        || !(trial.model.s.F >= 0.0 && trial.model.s.F <= trial.model.s.F_peak)
+        /* (Model Exchange takes the peak at accepted states: a state the host set may exceed it) */
+        || !(trial.model.s.F >= 0.0 && (trial.model.s.F <= trial.model.s.F_peak || trial.model_exchange))
         || (trial.model.s.in_contact != 0 && trial.model.s.in_contact != 1) || trial.model.s.steps < 0
         || trial.step.H < 0.0 || trial.step.span < 0.0 || trial.predicted < 0 || trial.computed < 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds a non-finite or impossible value");

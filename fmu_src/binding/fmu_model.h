@@ -18,9 +18,16 @@ enum fmu_vr {
 #define PARAMETER_MODEL_FMU_LIBRARY FMU_VR
 #define PARAMETER_FMU FMU_VR
 #define OUTPUT_FMU FMU_VR
+#define DERIVATIVE_FMU(name, type, unit, value, min, max, vr, ...) VR_der_##name = vr,
+#define STATE_FMU FMU_VR
+#define INDICATOR_FMU FMU_VR
 #include "parameters.def"
 };
 #undef FMU_VR
+
+/* Model Exchange's STATE rows: the element i (from 0) at vr + i, its
+ * derivative at vr + i + VR_DERIVATIVE_OFFSET (parameters.def). */
+#define VR_DERIVATIVE_OFFSET 1000
 
 /* What the master feeds to the striker (the parameter `coupling`): F_avg
  * after this FMU's step (Gauss-Seidel), or F_avg_next, read before the step

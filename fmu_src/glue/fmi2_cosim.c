@@ -1,7 +1,9 @@
 /* FMI 2.0 co-simulation glue: instances, the call-sequence state machine,
  * logging, communication times, the FMU state, and the translation of FMI
  * calls onto a model (fmu_interface.h). It knows the standard, not the
- * physics; the FMU it serves names itself in guid.h. */
+ * physics; the FMU it serves names itself in guid.h. Where that FMU has
+ * Model Exchange too (FMU_MODEL_EXCHANGE), the instances, variables and
+ * FMU state here serve it as well, and fmi2_me.c has its own functions. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -11,31 +13,25 @@
 
 #include "fmi2Functions.h"
 #include "fixed_values.h"
+#include "fmi2_states.h"
 #include "fmu_instance.h"
 #include "fmu_vars.h"
 #include "guid.h"
+#ifdef FMU_MODEL_EXCHANGE
+#include "fmu_me.h"
+#endif
 
-/* The states of FMI 2.0 §4.2.4 that this slave can be in, as bits, so that
- * each function names the set of states it may be called in. There is no
- * stepFailed, error or fatal state: a refused call changes nothing, and a
- * step that fails (fmi2Error) keeps the model at the start of the step, in
- * stepComplete, so the master may retry with a shorter step, restore a
- * state, reset, or terminate. */
-enum {
-    INSTANTIATED = 1 << 0,
-    INITIALIZATION_MODE = 1 << 1,
-    STEP_COMPLETE = 1 << 2,
-    TERMINATED = 1 << 4
-};
-
-/* As FMI 2.0 §4.2.4 names them. */
+/* As FMI 2.0 §3.2.3 and §4.2.4 name them (fmi2_states.h). */
 const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", "Step Complete", NULL,
-                                                   "Terminated"};
+                                                   "Terminated", "Event Mode", "Continuous-Time Mode"};
 const char *const fmu_type_names[3] = {"a Real", "an Integer", "a Boolean"};
 
-#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
-#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
-#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE)
+/* The states after initialization of the instance `in` at hand: Model
+ * Exchange's event and continuous-time modes, or co-simulation's step. */
+#define RUNNING (in && in->base.model_exchange ? ME_RUNNING : STEP_COMPLETE)
+#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | RUNNING | TERMINATED)
+#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | RUNNING | TERMINATED)
+#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | RUNNING)
 #define STEPPING (STEP_COMPLETE | TERMINATED)
 
 typedef struct {
@@ -84,10 +80,18 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         fail(&probe, "fmi2Instantiate: instanceName must be a non-empty string");
         return NULL;
     }
+#ifdef FMU_MODEL_EXCHANGE
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
+        fail(&probe, "fmi2Instantiate: fmuType = %d: this FMU supports fmi2ModelExchange (0) and fmi2CoSimulation (1)",
+             (int)fmuType);
+        return NULL;
+    }
+#else
     if (fmuType != fmi2CoSimulation) {
         fail(&probe, "fmi2Instantiate: this FMU supports co-simulation only");
         return NULL;
     }
+#endif
     if (!fmuGUID) {
         fail(&probe, "fmi2Instantiate: fmuGUID does not match modelDescription.xml (" FMU_GUID ")");
         return NULL;
@@ -107,6 +111,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         free(in);
         return NULL;
     }
+    in->base.model_exchange = fmuType == fmi2ModelExchange;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     return in;
 }
 
@@ -162,17 +171,22 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     instance *in = c;
     fm_status status;
     REQUIRE(INITIALIZATION_MODE, "fmi2ExitInitializationMode");
-    status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        status = fm_me_start(in->base.fm, in->base.start_time, in->base.stop_time);
+    else
+#endif
+        status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
     if (status == FM_ERROR)
         return fmi2Error;
-    in->base.state = STEP_COMPLETE;
+    in->base.state = in->base.model_exchange ? EVENT_MODE : STEP_COMPLETE;
     return (fmi2Status)status;
 }
 
 fmi2Status fmi2Terminate(fmi2Component c)
 {
     instance *in = c;
-    REQUIRE(STEP_COMPLETE, "fmi2Terminate");
+    REQUIRE(RUNNING, "fmi2Terminate");
     in->base.state = TERMINATED;
     return fmi2OK;
 }
@@ -182,6 +196,10 @@ fmi2Status fmi2Reset(fmi2Component c)
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi2Reset");
     fv_reset(&in->base);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;
@@ -335,8 +353,6 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 
 /* ------------------------------------------------------------ FMU state */
 
-#define STATE_MODES (INSTANTIATED | INITIALIZATION_MODE | STEP_COMPLETE | TERMINATED)
-
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     instance *in = c;
@@ -348,7 +364,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 {
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi2SetFMUstate");
-    return (fmi2Status)fi_set_state(&in->base, FMUstate, STATE_MODES, "fmi2SetFMUstate");
+    return (fmi2Status)fi_set_state(&in->base, FMUstate, ANY_STATE, "fmi2SetFMUstate");
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
@@ -395,13 +411,25 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nUnknown, const fmi2ValueReference vKnown_ref[],
                                         size_t nKnown, const fmi2Real dvKnown[], fmi2Real dvUnknown[])
 {
+    instance *in = c;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in && in->base.model_exchange) { /* its ModelExchange element provides them */
+        REQUIRE(AFTER_INIT_ENTERED, "fmi2GetDirectionalDerivative");
+        if (fi_null_arrays(&in->base, nUnknown, vUnknown_ref, dvUnknown, "fmi2GetDirectionalDerivative")
+            || fi_null_arrays(&in->base, nKnown, vKnown_ref, dvKnown, "fmi2GetDirectionalDerivative"))
+            return fmi2Error;
+        return fm_me_directional(in->base.fm, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown) == FM_OK
+                   ? fmi2OK
+                   : fmi2Error;
+    }
+#endif
     (void)vUnknown_ref;
     (void)nUnknown;
     (void)vKnown_ref;
     (void)nKnown;
     (void)dvKnown;
     (void)dvUnknown;
-    return unsupported(c, AFTER_INIT_ENTERED, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative");
+    return unsupported(in, AFTER_INIT_ENTERED, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,

@@ -2,37 +2,34 @@
  * (fmu_interface.h), with FMI 3.0's state machine, event mode, early return
  * at the model's events and the intermediate update callback. Instances,
  * logging and the FMU state are fmu_instance.c's, shared with fmi2_cosim.c.
- * It knows the standard, not the physics. */
+ * It knows the standard, not the physics. Where the FMU has Model Exchange
+ * too (FMU_MODEL_EXCHANGE), the instances, event mode, variables and FMU
+ * state here serve it as well, and fmi3_me.c has its own functions. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmi3Functions.h"
 #include "fixed_values.h"
+#include "fmi3_states.h"
 #include "fmu_instance.h"
 #include "fmu_vars.h"
 #include "guid.h"
+#ifdef FMU_MODEL_EXCHANGE
+#include "fmu_me.h"
+#endif
 
-/* The states of FMI 3.0 co-simulation (§4.2) this instance can be in, as
- * bits. As in the FMI 2.0 glue a refused call changes nothing, and a failed
- * step keeps the model at the start of that step (there is no error state). */
-enum {
-    INSTANTIATED = 1 << 0,
-    INITIALIZATION_MODE = 1 << 1,
-    EVENT_MODE = 1 << 5,
-    STEP_MODE = 1 << 6,
-    TERMINATED = 1 << 7
-};
-
-/* As FMI 3.0 §4.2 names them. */
-const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", NULL, NULL, NULL,
-                                                   "Event Mode", "Step Mode", "Terminated"};
+/* As FMI 3.0 §3.2 and §4.2 name them (fmi3_states.h). */
+const char *const fi_state_names[FI_STATE_BITS] = {"Instantiated", "Initialization Mode", "Continuous-Time Mode", NULL,
+                                                   NULL, "Event Mode", "Step Mode", "Terminated"};
 const char *const fmu_type_names[3] = {"a Float64", "an Int32", "a Boolean"};
 
-#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
-#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
-#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | EVENT_MODE | STEP_MODE)
-#define SIMULATING (EVENT_MODE | STEP_MODE)
+/* The states after initialization of the instance `in` at hand: Model
+ * Exchange's event and continuous-time modes, or co-simulation's. */
+#define SIMULATING (in && in->base.model_exchange ? ME_RUNNING : EVENT_MODE | STEP_MODE)
+#define ANY_STATE (INSTANTIATED | INITIALIZATION_MODE | ME_RUNNING | STEP_MODE | TERMINATED)
+#define AFTER_INIT_ENTERED (INITIALIZATION_MODE | SIMULATING | TERMINATED)
+#define SETTABLE (INSTANTIATED | INITIALIZATION_MODE | SIMULATING)
 
 #define VR_TIME 0u /* the independent variable */
 
@@ -119,10 +116,31 @@ static fmi3Instance other_interface(fmi3String instanceName, fmi3InstanceEnviron
     probe.environment = environment;
     probe.log_message = logMessage;
     fi_probe(&probe.base, instanceName, send_log);
+#ifdef FMU_MODEL_EXCHANGE
+    fail(&probe, "%s: this FMU supports model exchange and co-simulation only", name);
+#else
     fail(&probe, "%s: this FMU supports co-simulation only", name);
+#endif
     return NULL;
 }
 
+#ifdef FMU_MODEL_EXCHANGE
+/* Model Exchange (fmi3_me.c): the co-simulation's instance, its event mode
+ * used, no intermediate update. */
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage)
+{
+    instance *in = fmi3InstantiateCoSimulation(instanceName, instantiationToken, resourcePath, visible, loggingOn,
+                                               fmi3True, fmi3False, NULL, 0, instanceEnvironment, logMessage, NULL);
+    if (in) {
+        in->base.model_exchange = 1;
+        fm_me_instantiated(in->base.fm);
+    }
+    return in;
+}
+#else
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
                                           fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment,
@@ -134,6 +152,7 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
     (void)loggingOn;
     return other_interface(instanceName, instanceEnvironment, logMessage, "fmi3InstantiateModelExchange");
 }
+#endif
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
                                                fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
@@ -196,7 +215,12 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
     instance *in = c;
     fm_status status;
     REQUIRE(INITIALIZATION_MODE, "fmi3ExitInitializationMode");
-    status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        status = fm_me_start(in->base.fm, in->base.start_time, in->base.stop_time);
+    else
+#endif
+        status = fm_start(in->base.fm, in->base.start_time, in->base.stop_time);
     if (status == FM_ERROR)
         return fmi3Error;
     in->base.state = in->event_mode_used ? EVENT_MODE : STEP_MODE;
@@ -206,7 +230,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
 fmi3Status fmi3EnterEventMode(fmi3Instance c)
 {
     instance *in = c;
-    REQUIRE(STEP_MODE, "fmi3EnterEventMode");
+    REQUIRE(SIMULATING & ~EVENT_MODE, "fmi3EnterEventMode");
     if (!in->event_mode_used)
         return fail(in, "fmi3EnterEventMode: the instance was made with eventModeUsed = false");
     in->base.state = EVENT_MODE;
@@ -225,7 +249,12 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesN
     if (!discreteStatesNeedUpdate || !terminateSimulation || !nominalsOfContinuousStatesChanged
         || !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime)
         return fail(in, "fmi3UpdateDiscreteStates: an output argument is NULL");
-    fm_update_discrete(in->base.fm);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_event(in->base.fm);
+    else
+#endif
+        fm_update_discrete(in->base.fm);
     *discreteStatesNeedUpdate = fmi3False;
     *terminateSimulation = fmi3False;
     *nominalsOfContinuousStatesChanged = fmi3False;
@@ -239,6 +268,8 @@ fmi3Status fmi3EnterStepMode(fmi3Instance c)
 {
     instance *in = c;
     REQUIRE(EVENT_MODE, "fmi3EnterStepMode");
+    if (in->base.model_exchange)
+        return fail(in, "fmi3EnterStepMode: the instance was instantiated for model exchange, not co-simulation");
     in->base.state = STEP_MODE;
     return fmi3OK;
 }
@@ -256,6 +287,10 @@ fmi3Status fmi3Reset(fmi3Instance c)
     instance *in = c;
     REQUIRE(ANY_STATE, "fmi3Reset");
     fv_reset(&in->base);
+#ifdef FMU_MODEL_EXCHANGE
+    if (in->base.model_exchange)
+        fm_me_instantiated(in->base.fm);
+#endif
     in->base.start_time = 0.0;
     in->base.stop_time = INFINITY;
     in->base.state = INSTANTIATED;
@@ -528,7 +563,8 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[
 
 /* ------------------------------------------------------------ FMU state */
 
-#define STATE_MODES (INSTANTIATED | INITIALIZATION_MODE | EVENT_MODE | STEP_MODE | TERMINATED)
+/* the states of the instance's own interface */
+#define STATE_MODES (INSTANTIATED | INITIALIZATION_MODE | SIMULATING | TERMINATED)
 
 fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *FMUState)
 {
@@ -612,6 +648,22 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)
 {
+    instance *in = c;
+#ifdef FMU_MODEL_EXCHANGE
+    if (in && in->base.model_exchange) { /* its ModelExchange element provides them */
+        REQUIRE(AFTER_INIT_ENTERED, "fmi3GetDirectionalDerivative");
+        if (fi_null_arrays(&in->base, nUnknowns, unknowns, sensitivity, "fmi3GetDirectionalDerivative")
+            || fi_null_arrays(&in->base, nKnowns, knowns, seed, "fmi3GetDirectionalDerivative"))
+            return fmi3Error;
+        if (nSeed != nKnowns || nSensitivity != nUnknowns)
+            return fail(in, "fmi3GetDirectionalDerivative: nSeed = %lu and nSensitivity = %lu must be nKnowns = %lu "
+                            "and nUnknowns = %lu (every variable of this FMU is a scalar)", (unsigned long)nSeed,
+                        (unsigned long)nSensitivity, (unsigned long)nKnowns, (unsigned long)nUnknowns);
+        return fm_me_directional(in->base.fm, unknowns, nUnknowns, knowns, nKnowns, seed, sensitivity) == FM_OK
+                   ? fmi3OK
+                   : fmi3Error;
+    }
+#endif
     (void)unknowns;
     (void)nUnknowns;
     (void)knowns;
@@ -620,7 +672,7 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference
     (void)nSeed;
     (void)sensitivity;
     (void)nSensitivity;
-    return unsupported(c, AFTER_INIT_ENTERED, "fmi3GetDirectionalDerivative",
+    return unsupported(in, AFTER_INIT_ENTERED, "fmi3GetDirectionalDerivative",
                        NOT_DECLARED("providesDirectionalDerivatives"));
 }
 
@@ -628,6 +680,7 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unk
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                     size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)
 {
+    instance *in = c;
     (void)unknowns;
     (void)nUnknowns;
     (void)knowns;
@@ -636,7 +689,7 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unk
     (void)nSeed;
     (void)sensitivity;
     (void)nSensitivity;
-    return unsupported(c, AFTER_INIT_ENTERED, "fmi3GetAdjointDerivative", NOT_DECLARED("providesAdjointDerivatives"));
+    return unsupported(in, AFTER_INIT_ENTERED, "fmi3GetAdjointDerivative", NOT_DECLARED("providesAdjointDerivatives"));
 }
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance c)
@@ -737,6 +790,7 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance c, fmi3ValueReference clockRe
     return unsupported(c, ANY_STATE, "fmi3ActivateModelPartition", NOT_CO_SIMULATION);
 }
 
+#ifndef FMU_MODEL_EXCHANGE /* else fmi3_me.c */
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c)
 {
     return unsupported(c, ANY_STATE, "fmi3EnterContinuousTimeMode", NOT_CO_SIMULATION);
@@ -803,3 +857,4 @@ fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *nContinuousSt
     (void)nContinuousStates;
     return unsupported(c, ANY_STATE, "fmi3GetNumberOfContinuousStates", NOT_CO_SIMULATION);
 }
+#endif

@@ -24,6 +24,7 @@ typedef void (*fi_sink)(const fmu_instance *in, fi_status status, const char *ca
 struct fmu_instance {
     char *name;
     int state; /* one bit of the version's state machine */
+    int model_exchange; /* instantiated for Model Exchange (else co-simulation) */
     int logging_on;
     unsigned char category_on[FI_CATEGORIES];
     double start_time;
