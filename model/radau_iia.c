@@ -104,6 +104,15 @@ static inline complex_pair reciprocal(complex_pair a)
     return r;
 }
 
+/* Block 0, A's real eigenvalue, has coordinates of no imaginary part
+ * (to_blocks): its arithmetic is real, and the imaginary parts of its
+ * pairs are neither set nor read. 1 / x there, with reciprocal()'s
+ * arithmetic, so that it gives the bits of a pair of zero imaginary part. */
+static inline double real_reciprocal(double x)
+{
+    return x * (1.0 / (x * x));
+}
+
 /* h lambda_l. */
 static inline complex_pair h_lambda(double h, int l)
 {
@@ -319,7 +328,8 @@ static inline ALWAYS_INLINE int stage_indentations(const contact_model *cm, doub
         sigma += slope;
     }
     sigma *= 1.0 / STAGES;
-    for (l = 0; l < BLOCKS; l++) {
+    inverse[0].re = real_reciprocal(1.0 + sigma * mu[0].re);
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair jacobian = {1.0 + sigma * mu[l].re, sigma * mu[l].im};
         inverse[l] = reciprocal(jacobian);
     }
@@ -327,7 +337,8 @@ static inline ALWAYS_INLINE int stage_indentations(const contact_model *cm, doub
         complex_pair Ft[BLOCKS];
         double change = 0.0, scale = DBL_MIN;
         to_blocks(F, Ft);
-        for (l = 0; l < BLOCKS; l++) {
+        xi[0].re += (rho[0].re - xi[0].re - mu[0].re * Ft[0].re) * inverse[0].re;
+        for (l = 1; l < BLOCKS; l++) {
             const complex_pair muF = times(mu[l], Ft[l]);
             const complex_pair residual = {rho[l].re - xi[l].re - muF.re, rho[l].im - xi[l].im - muF.im};
             const complex_pair step = times(residual, inverse[l]);
@@ -378,10 +389,10 @@ static inline ALWAYS_INLINE radau_errors filtered_errors(const contact_model *cm
     int l;
     /* sum a d_0 r_phi with r_phi = w (z_n - b phi) + e . (Phi - phi) */
     rho = w * z_n * s->q[0].re - s->relaxed - RADAU_E_SUM * s->p[0].re;
-    for (l = 0; l < BLOCKS; l++) {
+    rho += radau_e_t[0] * (W[0].re * s->qq0 + s->pp0);
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair e_l = coordinate_weight(radau_e_t, l);
-        const complex_pair pp = l == 0 ? (complex_pair){s->pp0, 0.0} : with_d0(l, s->p[0].re, s->p[l]);
-        const complex_pair qq = l == 0 ? (complex_pair){s->qq0, 0.0} : with_d0(l, s->q[0].re, s->q[l]);
+        const complex_pair pp = with_d0(l, s->p[0].re, s->p[l]), qq = with_d0(l, s->q[0].re, s->q[l]);
         complex_pair sum = times(W[l], qq);
         sum.re += pp.re;
         sum.im += pp.im;
@@ -404,9 +415,9 @@ static inline ALWAYS_INLINE radau_errors filtered_errors(const contact_model *cm
  * (coordinate_weight). */
 static double weighted(const double w_t[STAGES], const complex_pair z[BLOCKS])
 {
-    double sum = 0.0;
+    double sum = w_t[0] * z[0].re;
     int l;
-    for (l = 0; l < BLOCKS; l++)
+    for (l = 1; l < BLOCKS; l++)
         sum += times(coordinate_weight(w_t, l), z[l]).re;
     return sum;
 }
@@ -428,7 +439,15 @@ static inline ALWAYS_INLINE void radau_trial(const int width, contact_model *cm,
      * pull, and the first guess x1 + c h (v - x2'), in the coordinates,
      * where the vectors 1, c = A 1 and c^2 = 2 A c (the collocation
      * conditions) have the coordinates 1, lambda_l and 2 lambda_l^2. */
-    for (l = 0; l < BLOCKS; l++) {
+    {
+        const double hl = h * radau_lambda[0][0], hl2 = hl * hl, ell0 = real_reciprocal(hl * s.q[0].re + eta);
+        const double hl_ell = hl * ell0;
+        ell[0].re = ell0;
+        mu[0].re = hl2 * inv_m + hl_ell * inv_c_alpha;
+        rho[0].re = x1 + hl * v + hl2 * accel + hl_ell * s.p[0].re;
+        xi[0].re = x1 + hl * slide;
+    }
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair hl = h_lambda(h, l), hl2 = times(hl, hl);
         complex_pair den = times(hl, s.q[l]), hl_ell, pull;
         den.re += eta;
@@ -453,7 +472,10 @@ static inline ALWAYS_INLINE void radau_trial(const int width, contact_model *cm,
         return;
     }
     to_blocks(F, Ft);
-    for (l = 0; l < BLOCKS; l++) {
+    Zt[0].re = ell[0].re * (Ft[0].re * inv_c_alpha - s.p[0].re);
+    W[0].re = h * radau_lambda[0][0] * Zt[0].re;
+    AFt[0].re = h * radau_lambda[0][0] * Ft[0].re;
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair hl = h_lambda(h, l);
         complex_pair force = {Ft[l].re * inv_c_alpha - s.p[l].re, Ft[l].im * inv_c_alpha - s.p[l].im};
         Zt[l] = times(ell[l], force);
