@@ -63,30 +63,27 @@ static const double radau_e_t[STAGES] = {-2.9488838958995656, -2.112506220735840
                                          1.0847440059486784, -1.789163750822806};
 #define RADAU_E_SUM (-3.9766461106867279)
 
-/* The passes over the modes, compiled for the CPU's widest vectors and
- * chosen at run time where GCC or Clang build for x86-64 (not for Windows,
- * where GCC does not align the stack for 32-byte vectors). Every version
- * gives the same bits (memory_sums_in_lanes, modes_to_last_stage). */
+/* The passes over the modes and the trial's own arithmetic, compiled for
+ * the CPU's widest vectors (and its three-operand instructions, which spare
+ * the copies of registers the scalar arithmetic of SSE2 needs) and chosen
+ * at run time where GCC or Clang build for x86-64 (not for Windows, where
+ * GCC does not align the stack for 32-byte vectors). Every version gives
+ * the same bits (memory_sums_in_lanes, modes_to_last_stage; C99 contracts
+ * no multiply-add, so the FMA of AVX-512 CPUs changes none). */
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(_WIN32) && !defined(CONTACT_NARROW_VECTORS)
 #define ALWAYS_INLINE __attribute__((always_inline))
-#define CPU_VERSIONS(name, params, args)                                        \
-    static void name##_sse2 params { name args; }                               \
-    __attribute__((target("avx"))) static void name##_avx params { name args; } \
-    __attribute__((target("avx512f"))) static void name##_avx512 params { name args; }
-/* the same with the lanes one vector holds as the first argument */
+/* name(lanes one vector holds, args...) for each CPU */
 #define CPU_WIDTH_VERSIONS(name, params, ...)                                                 \
     static void name##_sse2 params { name(2, __VA_ARGS__); }                                  \
     __attribute__((target("avx"))) static void name##_avx params { name(4, __VA_ARGS__); } \
     __attribute__((target("avx512f"))) static void name##_avx512 params { name(8, __VA_ARGS__); }
-#define CPU_VERSION(name, args)                                                                         \
-    (__builtin_cpu_supports("avx512f") ? name##_avx512 args : __builtin_cpu_supports("avx") ? name##_avx args \
-                                                                                          : name##_sse2 args)
-#define CPU_WIDTH_VERSION(name, width, ...) CPU_VERSION(name, (__VA_ARGS__))
+#define CPU_WIDTH_VERSION(name, width, ...)                                                                    \
+    (__builtin_cpu_supports("avx512f") ? name##_avx512(__VA_ARGS__)                                           \
+     : __builtin_cpu_supports("avx")   ? name##_avx(__VA_ARGS__)                                              \
+                                       : name##_sse2(__VA_ARGS__))
 #else
 #define ALWAYS_INLINE
-#define CPU_VERSIONS(name, params, args)
 #define CPU_WIDTH_VERSIONS(name, params, ...)
-#define CPU_VERSION(name, args) name args
 #define CPU_WIDTH_VERSION(name, width, ...) name(width, __VA_ARGS__)
 #endif
 
@@ -105,6 +102,15 @@ static inline complex_pair reciprocal(complex_pair a)
     const double n = 1.0 / (a.re * a.re + a.im * a.im);
     complex_pair r = {a.re * n, -a.im * n};
     return r;
+}
+
+/* Block 0, A's real eigenvalue, has coordinates of no imaginary part
+ * (to_blocks): its arithmetic is real, and the imaginary parts of its
+ * pairs are neither set nor read. 1 / x there, with reciprocal()'s
+ * arithmetic, so that it gives the bits of a pair of zero imaginary part. */
+static inline double real_reciprocal(double x)
+{
+    return x * (1.0 / (x * x));
 }
 
 /* h lambda_l. */
@@ -254,12 +260,10 @@ static inline ALWAYS_INLINE void memory_sums_in_lanes(const int width, contact_m
     }
 }
 
-CPU_WIDTH_VERSIONS(memory_sums_in_lanes, (contact_modes *m, double h, double sum[SUMS]), m, h, sum)
-
-static void memory_sums_of(contact_modes *m, double h, memory_sums *s)
+static inline ALWAYS_INLINE void memory_sums_of(const int width, contact_modes *m, double h, memory_sums *s)
 {
     double sum[SUMS];
-    CPU_WIDTH_VERSION(memory_sums_in_lanes, 2, m, h, sum);
+    memory_sums_in_lanes(width, m, h, sum);
     m->radau_h = h;
     s->p[0].re = sum[SUM_P0], s->p[0].im = 0.0, s->q[0].re = sum[SUM_Q0], s->q[0].im = 0.0;
     s->p[1].re = sum[SUM_P1R], s->p[1].im = sum[SUM_P1I], s->q[1].re = sum[SUM_Q1R], s->q[1].im = sum[SUM_Q1I];
@@ -311,9 +315,9 @@ static inline double force_and_slope(const contact_model *cm, double K, double X
  * coordinate by coordinate: no linear system. Where the slopes differ
  * little across the step, as everywhere but at an onset, it converges
  * nearly as fast as Newton's method. 0 when it did not converge. */
-static int stage_indentations(const contact_model *cm, double K, const complex_pair mu[BLOCKS],
-                              const complex_pair rho[BLOCKS], complex_pair xi[BLOCKS], double X[STAGES],
-                              double F[STAGES])
+static inline ALWAYS_INLINE int stage_indentations(const contact_model *cm, double K, const complex_pair mu[BLOCKS],
+                                                    const complex_pair rho[BLOCKS], complex_pair xi[BLOCKS],
+                                                    double X[STAGES], double F[STAGES])
 {
     complex_pair inverse[BLOCKS];
     const double settled = NEWTON_SETTLED * cm->p.tolerance;
@@ -324,7 +328,8 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
         sigma += slope;
     }
     sigma *= 1.0 / STAGES;
-    for (l = 0; l < BLOCKS; l++) {
+    inverse[0].re = real_reciprocal(1.0 + sigma * mu[0].re);
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair jacobian = {1.0 + sigma * mu[l].re, sigma * mu[l].im};
         inverse[l] = reciprocal(jacobian);
     }
@@ -332,7 +337,8 @@ static int stage_indentations(const contact_model *cm, double K, const complex_p
         complex_pair Ft[BLOCKS];
         double change = 0.0, scale = DBL_MIN;
         to_blocks(F, Ft);
-        for (l = 0; l < BLOCKS; l++) {
+        xi[0].re += (rho[0].re - xi[0].re - mu[0].re * Ft[0].re) * inverse[0].re;
+        for (l = 1; l < BLOCKS; l++) {
             const complex_pair muF = times(mu[l], Ft[l]);
             const complex_pair residual = {rho[l].re - xi[l].re - muF.re, rho[l].im - xi[l].im - muF.im};
             const complex_pair step = times(residual, inverse[l]);
@@ -371,8 +377,9 @@ typedef struct {
     double x1, v, x2;
 } stage_differences;
 
-static radau_errors filtered_errors(const contact_model *cm, const contact_state *in, double h, double K,
-                                    const memory_sums *s, stage_differences d, const complex_pair W[BLOCKS])
+static inline ALWAYS_INLINE radau_errors filtered_errors(const contact_model *cm, const contact_state *in, double h,
+                                                         double K, const memory_sums *s, stage_differences d,
+                                                         const complex_pair W[BLOCKS])
 {
     const double w = radau_lambda[0][0] * h, inv_c_alpha = 1.0 / cm->p.c_alpha, inv_m = cm->inv_m, z_n = in->x2_rate;
     const double r_x1 = w * (in->v - z_n) + d.x1, r_v = w * (cm->accel - inv_m * in->F) + d.v;
@@ -382,10 +389,10 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
     int l;
     /* sum a d_0 r_phi with r_phi = w (z_n - b phi) + e . (Phi - phi) */
     rho = w * z_n * s->q[0].re - s->relaxed - RADAU_E_SUM * s->p[0].re;
-    for (l = 0; l < BLOCKS; l++) {
+    rho += radau_e_t[0] * (W[0].re * s->qq0 + s->pp0);
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair e_l = coordinate_weight(radau_e_t, l);
-        const complex_pair pp = l == 0 ? (complex_pair){s->pp0, 0.0} : with_d0(l, s->p[0].re, s->p[l]);
-        const complex_pair qq = l == 0 ? (complex_pair){s->qq0, 0.0} : with_d0(l, s->q[0].re, s->q[l]);
+        const complex_pair pp = with_d0(l, s->p[0].re, s->p[l]), qq = with_d0(l, s->q[0].re, s->q[l]);
         complex_pair sum = times(W[l], qq);
         sum.re += pp.re;
         sum.im += pp.im;
@@ -408,14 +415,15 @@ static radau_errors filtered_errors(const contact_model *cm, const contact_state
  * (coordinate_weight). */
 static double weighted(const double w_t[STAGES], const complex_pair z[BLOCKS])
 {
-    double sum = 0.0;
+    double sum = w_t[0] * z[0].re;
     int l;
-    for (l = 0; l < BLOCKS; l++)
+    for (l = 1; l < BLOCKS; l++)
         sum += times(coordinate_weight(w_t, l), z[l]).re;
     return sum;
 }
 
-double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+static inline ALWAYS_INLINE void radau_trial(const int width, contact_model *cm, const contact_state *in, double h,
+                                             double K, contact_state *out, double *J)
 {
     const double inv_c_alpha = 1.0 / cm->p.c_alpha, eta = cm->modes.eta, inv_m = cm->inv_m, accel = cm->accel;
     const double x1 = in->x1, v = in->v, slide = in->v - in->x2_rate;
@@ -426,12 +434,20 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     stage_differences d;
     radau_errors e;
     int i, l;
-    memory_sums_of(&cm->modes, h, &s);
+    memory_sums_of(width, &cm->modes, h, &s);
     /* The start's motion r = x1 + c h v + c^2 h^2 accel / 2 + the memory's
      * pull, and the first guess x1 + c h (v - x2'), in the coordinates,
      * where the vectors 1, c = A 1 and c^2 = 2 A c (the collocation
      * conditions) have the coordinates 1, lambda_l and 2 lambda_l^2. */
-    for (l = 0; l < BLOCKS; l++) {
+    {
+        const double hl = h * radau_lambda[0][0], hl2 = hl * hl, ell0 = real_reciprocal(hl * s.q[0].re + eta);
+        const double hl_ell = hl * ell0;
+        ell[0].re = ell0;
+        mu[0].re = hl2 * inv_m + hl_ell * inv_c_alpha;
+        rho[0].re = x1 + hl * v + hl2 * accel + hl_ell * s.p[0].re;
+        xi[0].re = x1 + hl * slide;
+    }
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair hl = h_lambda(h, l), hl2 = times(hl, hl);
         complex_pair den = times(hl, s.q[l]), hl_ell, pull;
         den.re += eta;
@@ -452,10 +468,14 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     out->step = h;
     if (!stage_indentations(cm, K, mu, rho, xi, X, F)) {
         out->error = INFINITY;
-        return 0.0;
+        *J = 0.0;
+        return;
     }
     to_blocks(F, Ft);
-    for (l = 0; l < BLOCKS; l++) {
+    Zt[0].re = ell[0].re * (Ft[0].re * inv_c_alpha - s.p[0].re);
+    W[0].re = h * radau_lambda[0][0] * Zt[0].re;
+    AFt[0].re = h * radau_lambda[0][0] * Ft[0].re;
+    for (l = 1; l < BLOCKS; l++) {
         const complex_pair hl = h_lambda(h, l);
         complex_pair force = {Ft[l].re * inv_c_alpha - s.p[l].re, Ft[l].im * inv_c_alpha - s.p[l].im};
         Zt[l] = times(ell[l], force);
@@ -488,7 +508,20 @@ double radau_step(contact_model *cm, const contact_state *in, double h, double K
     out->x2_rate = Z[STAGES - 1];
     error = larger(larger(fabs(e.x1), fabs(e.x2)), fabs(e.memory)) / error_length(cm, in, K, out);
     out->error = larger(error, fabs(e.v) / error_speed(in, out)) / cm->p.tolerance;
-    return impulse;
+    *J = impulse;
+}
+
+CPU_WIDTH_VERSIONS(radau_trial,
+                   (contact_model * cm, const contact_state *in, double h, double K, contact_state *out, double *J),
+                   cm, in, h, K, out, J)
+
+/* One trial step of length h from *in into *out (its error ratio in
+ * out->error, INFINITY where the stages' iteration failed): its impulse. */
+double radau_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    double J;
+    CPU_WIDTH_VERSION(radau_trial, 2, cm, in, h, K, out, &J);
+    return J;
 }
 
 /* Each mode to the last stage's value, elementwise from the reciprocals the
@@ -514,14 +547,10 @@ static inline ALWAYS_INLINE void modes_to_last_stage(contact_modes *m, const com
     }
 }
 
-CPU_VERSIONS(modes_to_last_stage,
-             (contact_modes * m, const complex_pair tau[BLOCKS], const complex_pair tau_W[BLOCKS]),
-             (m, tau, tau_W))
-
 /* The modes after an accepted step: the last stage's (stiffly accurate),
  * Phi = (I + h b A)^-1 (phi_n 1 + h A Z) in the coordinates, from the
  * trial's stage rates Z. */
-void radau_advance_modes(contact_model *cm, const contact_state *trial)
+static inline ALWAYS_INLINE void accepted_modes(const int width, contact_model *cm, const contact_state *trial)
 {
     contact_modes *m = &cm->modes;
     const double h = trial->step;
@@ -530,7 +559,7 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
     int l;
     if (m->radau_h != h) { /* another trial came after it (an event's search) */
         memory_sums unused;
-        memory_sums_of(m, h, &unused);
+        memory_sums_of(width, m, h, &unused);
     }
     Z[0] = trial->x2_rate1;
     memcpy(Z + 1, trial->x2_rate_inner, sizeof trial->x2_rate_inner);
@@ -540,7 +569,14 @@ void radau_advance_modes(contact_model *cm, const contact_state *trial)
         tau[l] = coordinate_weight(radau_t[STAGES - 1], l);
         tau_W[l] = times(tau[l], times(h_lambda(h, l), Zt[l]));
     }
-    CPU_VERSION(modes_to_last_stage, (m, tau, tau_W));
+    modes_to_last_stage(m, tau, tau_W);
+}
+
+CPU_WIDTH_VERSIONS(accepted_modes, (contact_model * cm, const contact_state *trial), cm, trial)
+
+void radau_advance_modes(contact_model *cm, const contact_state *trial)
+{
+    CPU_WIDTH_VERSION(accepted_modes, 2, cm, trial);
 }
 
 /* The dense output: the polynomial through (theta_i, y_i) at the nodes
