@@ -17,10 +17,11 @@ import pytest
 from lxml import etree
 
 import fmpy.ssp
+import fraccontact
 from fraccontact import fmu_path, omsimulator
 from fraccontact.cosim import cosimulate
 from fraccontact.scenes import masters, systems
-from fraccontact.ssp import run_omsimulator, ssp_path
+from fraccontact.ssp import run_omsimulator, ssp_path, with_exported
 
 SCHEMA = pathlib.Path(fmpy.ssp.__file__).parent / "schema" / "SystemStructureDescription.xsd"
 NS = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -168,3 +169,22 @@ def test_omsimulator_absent_is_refused_on_one_line(tmp_path):
     assert r.returncode == 2 and r.stdout == ""
     assert "OMSimulator is not installed: put OMSimulator on PATH or set FRACCONTACT_OMSIMULATOR" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+
+
+@installed
+def test_a_scene_of_exported_contacts_gives_omsimulator_the_shipped_scenes_figures(tmp_path):
+    """The headform scene with both contacts exported for it (docs/export.md:
+    the same binary, the values fixed in its resources) runs in OMSimulator
+    as the shipped SSP does, to the last bit of every figure."""
+    values = systems.headform_values()
+    fmus = {}
+    for contact, bodies in (("skin", 2), ("hard", 1)):
+        fixed = {n: x for n, x in values[contact].items() if n not in ("scene", "coupling")}
+        fmus[contact] = tmp_path / f"{contact}.fmu"
+        fraccontact.export(fmus[contact], scene="driven", bodies=bodies, coupling="jacobi", values=fixed)
+    exported = tmp_path / "headform_exported.ssp"
+    with_exported(SSPS["headform"], fmus, exported)
+    shipped, ours = (scene_command("headform", "--ssp", str(path), "--master", "omsimulator")
+                     for path in (SSPS["headform"], exported))
+    assert shipped.returncode == 0 and ours.returncode == 0, (shipped.stderr, ours.stderr)
+    assert json.loads(ours.stdout) == json.loads(shipped.stdout)
