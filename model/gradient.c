@@ -81,8 +81,9 @@ static double power_mean_force(double K, double n, double x1, double rho, double
  * whose root is X >= 0 where c1 < 0. G is convex for s >= 0, so Newton's
  * method converges monotonically from above: from the root of
  * s^2 + q s^3 = x1 + rho (stage_root), above it since the secant is at
- * least (2K/5) s^3. Returns -1 where the root is X < 0. */
-static inline double hertz_mean_force(double K, double x1, double rho, double b, double *X)
+ * least (2K/5) s^3. Returns -1 where the root is X < 0; the spring's
+ * force at X in *F_end. */
+static inline double hertz_mean_force(double K, double x1, double rho, double b, double *X, double *F_end)
 {
     const double q = 0.4 * b * K, s0 = sqrt(x1), c3 = 1.0 + q * s0, c1 = q * s0 * x1 - (x1 + rho);
     double s, ds;
@@ -98,27 +99,34 @@ static inline double hertz_mean_force(double K, double x1, double rho, double b,
             break;
     }
     *X = s * s;
+    *F_end = K * s * *X;
     return 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
 }
 
-/* The step's mean spring force F and its end X: the root of
- * X - x1 + b F(x1, X) = rho. */
-static inline double mean_force(const contact_model *cm, double K, double x1, double rho, double b, double *X)
+/* The step's mean spring force F and its end X, the root of
+ * X - x1 + b F(x1, X) = rho, and the spring's force at X in *F_end. */
+static inline double mean_force(const contact_model *cm, double K, double x1, double rho, double b, double *X,
+                                double *F_end)
 {
     const double n = cm->p.spring_exponent;
     double F;
     if (!(K > 0.0)) { /* out of contact the striker moves freely */
         *X = x1 + rho;
+        *F_end = 0.0;
         return 0.0;
     }
-    if (n == 1.5 && x1 >= 0.0 && (F = hertz_mean_force(K, x1, rho, b, X)) >= 0.0)
+    if (n == 1.5 && x1 >= 0.0 && (F = hertz_mean_force(K, x1, rho, b, X, F_end)) >= 0.0)
         return F;
-    if (n == 1.0 && x1 >= 0.0) { /* a linear spring: the secant is K (X + x1)/2 */
+    F = -1.0;
+    if (n == 1.0 && x1 >= 0.0) { /* a linear spring: the secant is K (X + x1)/2 while X >= 0 */
         *X = (x1 + rho - 0.5 * b * K * x1) / (1.0 + 0.5 * b * K);
         if (*X >= 0.0)
-            return 0.5 * K * (*X + x1);
+            F = 0.5 * K * (*X + x1);
     }
-    return power_mean_force(K, n, x1, rho, b, X);
+    if (F < 0.0)
+        F = power_mean_force(K, n, x1, rho, b, X);
+    *F_end = *X > 0.0 ? spring_force(cm, K, *X) : 0.0;
+    return F;
 }
 
 /* The springpot F = c_alpha (eta x2' + sum_i a_i phi_i), phi_i' = -b_i phi_i
@@ -191,14 +199,14 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     const damper_stage d = compressed ? springpot_mean(cm, h) : (damper_stage){0.0, cm->inv_c};
     /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B */
     const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (in->v + 0.5 * h * cm->accel + d.A * d.inv_B);
-    double X;
-    const double F = mean_force(cm, K, in->x1, rho, b, &X), z = (F - d.A) * d.inv_B;
+    double X, F_end;
+    const double F = mean_force(cm, K, in->x1, rho, b, &X, &F_end), z = (F - d.A) * d.inv_B;
 
     carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X;
     out->v = in->v + h * (cm->accel - cm->inv_m * F);
-    out->F = X > 0.0 && K > 0.0 ? spring_force(cm, K, X) : 0.0;
+    out->F = F_end;
     out->step = h;
     out->x2_rate1 = z;
     out->x2_rate = springpot(cm) ? z : out->F * cm->inv_c;
