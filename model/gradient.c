@@ -17,22 +17,23 @@
 
 
 /* The discrete gradient of V(x) = K max(x, 0)^(n+1)/(n+1) between x1 and X,
- * (V(X) - V(x1))/(X - x1), for any exponent n: near X = x1 > 0, where the
- * secant cancels, its series about the midpoint m,
- *     K m^n (1 + n(n-1) r^2/24 (1 + (n-2)(n-3) r^2/80)),   r = (X - x1)/m,
- * whose next term is below rounding for |r| < 1e-3. */
+ * (V(X) - V(x1))/(X - x1), for any exponent n, to a few roundings at any
+ * X: where the two are close (hi <= 2 lo), as
+ *     K lo^n expm1((n+1) u) / ((n+1) expm1(u)),   u = log1p((hi - lo)/lo),
+ * without the secant's cancellation, which would make it noisy in X, and
+ * the step's root with it (the root's residual is energy). */
 static double secant_force(double K, double n, double x1, double X)
 {
-    const double lo = smaller(x1, X), hi = larger(x1, X), m = 0.5 * (x1 + X);
-    double r;
+    const double lo = smaller(x1, X), hi = larger(x1, X);
+    double u;
     if (!(hi > 0.0))
         return 0.0;
     if (!(lo > 0.0))
         return K * pow(hi, n + 1.0) / ((n + 1.0) * (hi - lo));
-    r = (X - x1) / m;
-    if (fabs(r) < 1e-3)
-        return K * pow(m, n) * (1.0 + n * (n - 1.0) / 24.0 * r * r * (1.0 + (n - 2.0) * (n - 3.0) / 80.0 * r * r));
-    return K * (pow(X, n + 1.0) - pow(x1, n + 1.0)) / ((n + 1.0) * (X - x1));
+    if (hi > 2.0 * lo)
+        return K * (pow(hi, n + 1.0) - pow(lo, n + 1.0)) / ((n + 1.0) * (hi - lo));
+    u = log1p((hi - lo) / lo);
+    return u > 0.0 ? K * pow(lo, n) * expm1((n + 1.0) * u) / ((n + 1.0) * expm1(u)) : K * pow(lo, n);
 }
 
 /* The root X of X - x1 + b F(x1, X) = rho (b >= 0, K > 0) for any exponent
@@ -50,9 +51,13 @@ static double power_mean_force(double K, double n, double x1, double rho, double
     for (i = 0; i < 200; i++) {
         const double F = secant_force(K, n, x1, x), g = x - x1 + b * F - rho, d = x - x1, m = 0.5 * (x1 + x);
         /* the secant's slope in X: (F(X) - F)/(X - x1), or near X = x1 > 0
-         * half the spring's stiffness at the midpoint */
-        const double slope = m > 0.0 && fabs(d) <= 1e-3 * m ? 0.5 * n * K * pow(m, n - 1.0)
-                                                            : (K * pow(larger(x, 0.0), n) - F) / d;
+         * the slope of its series, (n K m^(n-1)/2) (1 + (n-1) r/6 (1 + (n-2) r/4)),
+         * exact to O(r^3): where the dashpot is stiff (b slope >> 1) the
+         * slope's error is the rate at which Newton's method converges */
+        const double r = m > 0.0 ? d / m : 0.0;
+        const double slope = m > 0.0 && fabs(r) <= 1e-3
+                                 ? 0.5 * n * K * pow(m, n - 1.0) * (1.0 + (n - 1.0) * r / 6.0 * (1.0 + (n - 2.0) * r / 4.0))
+                                 : (K * pow(larger(x, 0.0), n) - F) / d;
         const double next = x - g / (1.0 + b * slope);
         if (g > 0.0)
             hi = x;
