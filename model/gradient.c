@@ -15,6 +15,14 @@
 
 #include "stage.h"
 
+/* The step's root inline in it: a call there costs the fixed steps more
+ * than the noise (tests/instruction_counts.tsv). */
+#if defined(__GNUC__)
+#define HOT_INLINE inline __attribute__((always_inline))
+#else
+#define HOT_INLINE inline
+#endif
+
 
 /* The discrete gradient of V(x) = K max(x, 0)^(n+1)/(n+1) between x1 and X,
  * (V(X) - V(x1))/(X - x1), for any exponent n, to a few roundings at any
@@ -36,29 +44,52 @@ static double secant_force(double K, double n, double x1, double X)
     return u > 0.0 ? K * pow(lo, n) * expm1((n + 1.0) * u) / ((n + 1.0) * expm1(u)) : K * pow(lo, n);
 }
 
-/* The root X of X - x1 + b F(x1, X) = rho (b >= 0, K > 0) for any exponent
- * and sign of x1 and X, and the secant F there: the left side increases
- * with X (V is convex) and the root lies in [hi - b K top^n, hi],
- * hi = x1 + rho, top the larger of hi and x1 (below hi the secant is at
- * most K top^n). Newton's method
- * from hi, kept inside the bracket, bisecting where it leaves it, until a
- * Newton step below 1e-8 of X leaves the root exact to rounding: the
- * energy a step keeps is off by F times the root's residual. */
-static double power_mean_force(double K, double n, double x1, double rho, double b, double *X)
+/* The step's force (docs/model.md §11): the blend
+ *     F = (1 - theta) S + theta K max(X, 0)^n
+ * of the discrete gradient S = secant_force and the spring's force at the
+ * step's end, theta = z/(2 + z) with z = h lambda, lambda the rate at which
+ * the damper relaxes the spring at the step's start. theta is O(h) where
+ * the step resolves that relaxation (second order kept) and tends to 1
+ * where it does not, which damps it as L-stability does instead of
+ * letting the elastic indentation ring from step to step. */
+typedef struct {
+    double F, S, F_end; /* the step's force, the discrete gradient, the spring's force at X */
+    double theta;
+} step_force;
+
+/* theta from h inv_B (the damper's compliance over the step) and the
+ * spring's stiffness F'(x1) at the step's start. */
+static double relaxation_weight(double h_inv_B, double stiffness)
+{
+    const double z = h_inv_B * stiffness;
+    return z / (2.0 + z);
+}
+
+/* The root X of X - x1 + b F(X) = rho (b >= 0, K > 0) for any exponent and
+ * sign of x1 and X: the left side increases with X (the secant of a convex
+ * V does, and so does the spring's force) and the root lies in
+ * [hi - b K top^n, hi], hi = x1 + rho, top the larger of hi and x1 (below
+ * hi the force is at most K top^n). Newton's method from hi, kept inside
+ * the bracket, bisecting where it leaves it, until a Newton step below
+ * 1e-8 of X leaves the root exact to rounding: the energy a step keeps is
+ * off by F times the root's residual. */
+static step_force power_mean_force(double K, double n, double theta, double x1, double rho, double b, double *X)
 {
     double hi = x1 + rho, lo = hi - b * K * pow(larger(larger(hi, x1), 0.0), n), x = hi;
+    step_force f;
     int i;
     for (i = 0; i < 200; i++) {
-        const double F = secant_force(K, n, x1, x), g = x - x1 + b * F - rho, d = x - x1, m = 0.5 * (x1 + x);
-        /* the secant's slope in X: (F(X) - F)/(X - x1), or near X = x1 > 0
+        const double S = secant_force(K, n, x1, x), F_end = K * pow(larger(x, 0.0), n), d = x - x1;
+        const double m = 0.5 * (x1 + x), r = m > 0.0 ? d / m : 0.0, g = x - x1 + b * ((1.0 - theta) * S + theta * F_end) - rho;
+        /* the secant's slope in X: (F(X) - S)/(X - x1), or near X = x1 > 0
          * the slope of its series, (n K m^(n-1)/2) (1 + (n-1) r/6 (1 + (n-2) r/4)),
          * exact to O(r^3): where the dashpot is stiff (b slope >> 1) the
          * slope's error is the rate at which Newton's method converges */
-        const double r = m > 0.0 ? d / m : 0.0;
         const double slope = m > 0.0 && fabs(r) <= 1e-3
                                  ? 0.5 * n * K * pow(m, n - 1.0) * (1.0 + (n - 1.0) * r / 6.0 * (1.0 + (n - 2.0) * r / 4.0))
-                                 : (K * pow(larger(x, 0.0), n) - F) / d;
-        const double next = x - g / (1.0 + b * slope);
+                                 : (F_end - S) / d;
+        const double end_slope = x > 0.0 ? n * K * pow(x, n - 1.0) : 0.0;
+        const double next = x - g / (1.0 + b * ((1.0 - theta) * slope + theta * end_slope));
         if (g > 0.0)
             hi = x;
         else
@@ -75,79 +106,109 @@ static double power_mean_force(double K, double n, double x1, double rho, double
         }
     }
     *X = x;
-    return secant_force(K, n, x1, x);
+    f.S = secant_force(K, n, x1, x);
+    f.F_end = K * pow(larger(x, 0.0), n);
+    f.F = f.S + theta * (f.F_end - f.S);
+    return f;
 }
 
 /* The same for the Hertz sphere's n = 3/2 from x1 >= 0 to X >= 0, the
  * common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
- * (2K/5)(s^4/(s + s0) + s0 s^2 + s0^3), and (s + s0) times the equation is
- *     G(s) = q s^4 + c3 s^2 (s + s0) + c1 (s + s0),
- *     q = 2 b K/5,  c3 = 1 + q s0,  c1 = q s0^3 - (x1 + rho),
+ * (2K/5)(s^4/(s + s0) + s0 s^2 + s0^3) and the end's force K s^3, and
+ * (s + s0) times the equation is
+ *     G(s) = (q + w) s^4 + w s0 s^3 + c3 s^2 (s + s0) + c1 (s + s0),
+ *     q = (1 - theta) 2 b K/5,  w = theta b K,  c3 = 1 + q s0,  c1 = q s0^3 - (x1 + rho),
  * whose root is X >= 0 where c1 < 0. G is convex for s >= 0, so Newton's
- * method converges monotonically from above: from the root of
- * s^2 + q s^3 = x1 + rho (stage_root), above it since the secant is at
- * least (2K/5) s^3. Returns -1 where the root is X < 0; the spring's
- * force at X in *F_end. */
-static inline double hertz_mean_force(double K, double x1, double rho, double b, double *X, double *F_end)
+ * method converges monotonically from above, and from below where G
+ * rises: from X's Chebyshev step off x1, x1 + d, d = d1 - g2 d1^2/(2 g1),
+ * d1 = -g0/g1, with g0, g1, g2 the left side X - x1 + b F - rho and its
+ * first two derivatives at x1 (F = K x1^(3/2), F' = 3/2 K s0, F'' = 3/4
+ * K/s0; the secant's derivatives there are 1/2 and 1/3 of the force's),
+ * which is off by O(d^3) and so, where the step moves x1 little, leaves
+ * one Newton iteration to rounding; where that start is no root's (x1 = 0,
+ * or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
+ * (stage_root), above the root since the force is at least (q + w)/b s^3.
+ * Returns 0 where the root is X < 0. */
+static inline int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
+                                   step_force *f)
 {
-    const double q = 0.4 * b * K, s0 = sqrt(x1), c3 = 1.0 + q * s0, c1 = q * s0 * x1 - (x1 + rho);
-    double s, ds;
+    const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, ws0 = w * s0, c3 = 1.0 + q * s0;
+    const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = q + w;
+    double s = -1.0, ds;
     int i;
     if (!(c1 < 0.0))
-        return -1.0;
-    s = stage_root(x1 + rho, q, 0.0);
+        return 0;
+    if (x1 > 0.0) {
+        const double g1 = 1.0 + 0.75 * bK * s0 * (1.0 + theta), d1 = (rho - bF) / g1;
+        s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
+    }
+    if (!(s > 0.0))
+        s = stage_root(x1 + rho, q4, 0.0);
     for (i = 0; i < 200; i++) {
-        const double ss = s * s, t = s + s0;
-        ds = (ss * (q * ss + c3 * t) + c1 * t) / (s * (4.0 * q * ss + c3 * (3.0 * s + 2.0 * s0)) + c1);
+        const double ss = s * s, t = s + s0, slope = s * (4.0 * q4 * ss + 3.0 * ws0 * s + c3 * (3.0 * s + 2.0 * s0)) + c1;
+        if (!(slope > 0.0)) { /* a start below the root where G falls: from above instead */
+            s = stage_root(x1 + rho, q4, 0.0);
+            continue;
+        }
+        ds = (ss * (q4 * ss + ws0 * s + c3 * t) + c1 * t) / slope;
         s -= ds;
         if (!(fabs(ds) > 1e-8 * s))
             break;
     }
     *X = s * s;
-    *F_end = K * s * *X;
-    return 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
+    f->F_end = K * s * *X;
+    f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
+    f->F = f->S + theta * (f->F_end - f->S);
+    return 1;
 }
 
-/* The step's mean spring force F and its end X, the root of
- * X - x1 + b F(x1, X) = rho, and the spring's force at X in *F_end. */
-static inline double mean_force(const contact_model *cm, double K, double x1, double rho, double b, double *X,
-                                double *F_end)
+/* The step's force and its end X, the root of X - x1 + b F(X) = rho. */
+static HOT_INLINE step_force mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho,
+                                    double b, double *X)
 {
     const double n = cm->p.spring_exponent;
-    double F;
+    step_force f = {0.0, 0.0, 0.0, 0.0};
+    double theta, s0;
     if (!(K > 0.0)) { /* out of contact the striker moves freely */
         *X = x1 + rho;
-        *F_end = 0.0;
-        return 0.0;
+        return f;
     }
-    if (n == 1.5 && x1 >= 0.0 && (F = hertz_mean_force(K, x1, rho, b, X, F_end)) >= 0.0)
-        return F;
-    F = -1.0;
-    if (n == 1.0 && x1 >= 0.0) { /* a linear spring: the secant is K (X + x1)/2 while X >= 0 */
-        *X = (x1 + rho - 0.5 * b * K * x1) / (1.0 + 0.5 * b * K);
-        if (*X >= 0.0)
-            F = 0.5 * K * (*X + x1);
+    if (n == 1.5 && x1 >= 0.0) {
+        s0 = sqrt(x1);
+        f.theta = theta = relaxation_weight(h_inv_B, 1.5 * K * s0);
+        if (hertz_mean_force(K, theta, x1, s0, rho, b, X, &f))
+            return f;
     }
-    if (F < 0.0)
-        F = power_mean_force(K, n, x1, rho, b, X);
-    *F_end = *X > 0.0 ? spring_force(cm, K, *X) : 0.0;
-    return F;
+    f.theta = theta = x1 > 0.0 || n == 1.0 ? relaxation_weight(h_inv_B, n * K * pow(larger(x1, 0.0), n - 1.0)) : 0.0;
+    if (n == 1.0 && x1 >= 0.0) { /* a linear spring: F = K (X (1 + theta) + x1 (1 - theta))/2 while X >= 0 */
+        *X = (x1 + rho - 0.5 * b * K * (1.0 - theta) * x1) / (1.0 + 0.5 * b * K * (1.0 + theta));
+        if (*X >= 0.0) {
+            f.S = 0.5 * K * (*X + x1);
+            f.F_end = K * *X;
+            f.F = f.S + theta * (f.F_end - f.S);
+            return f;
+        }
+    }
+    f = power_mean_force(K, n, theta, x1, rho, b, X);
+    f.theta = theta;
+    return f;
 }
 
 /* The springpot F = c_alpha (eta x2' + sum_i a_i phi_i), phi_i' = -b_i phi_i
  * + x2' (docs/model.md §6), over a step of length h: each mode i, a Maxwell
  * arm of a spring c_alpha a_i and a dashpot, steps as
- *     phi_i' - phi_i = mu_i h z - beta_i (phi_i + phi_i')/2,
+ *     phi_i' - phi_i = mu_i h z - beta_i m_i,   m_i = (phi_i + phi_i')/2,
  *     beta_i = 2 tanh(h b_i/2),  mu_i = beta_i/(h b_i)  (1 at b_i = 0)
- * and pulls with c_alpha a_i mu_i (phi_i + phi_i')/2 over it: the work of
- * that pull over the travel h z exceeds the spring's change of energy by
- * c_alpha a_i beta_i times the mean stretch squared, so each mode
+ * and pulls with c_alpha a_i (mu_i m_i + (1 - mu_i) z/b_i) over it: the work
+ * of that pull over the travel h z exceeds the spring's change of energy by
+ * c_alpha a_i (beta_i m_i^2 + (1 - mu_i) h z^2/b_i) >= 0, so each mode
  * dissipates; and the step is exact where the mode relaxes freely (keep_i
- * = e^(-h b_i)) and where it flows at a steady rate (phi_i = z/b_i). With
- * d_i = 1/(1 + beta_i/2) the mean pull is linear in z,
- * c_alpha (sum p_i phi_i + z h/2 sum q_i), p_i = a_i mu_i d_i, q_i = p_i mu_i;
- * the coefficients depend on h alone and are kept for the step length
- * last used. */
+ * = e^(-h b_i), which damps a mode far faster than the step at once) and
+ * where it flows at a steady rate (phi_i = z/b_i, pulling a_i z/b_i, the
+ * viscosity of a fast mode). With d_i = 1/(1 + beta_i/2) the mean pull is
+ * linear in z, c_alpha (sum p_i phi_i + z h/2 sum q_i), p_i = a_i mu_i d_i,
+ * q_i = p_i mu_i + 2 a_i (1 - mu_i)/(h b_i); the coefficients depend on h
+ * alone and are kept for the step length last used. */
 static const contact_modes *modes_for_step(contact_model *cm, double h)
 {
     contact_modes *m = &cm->modes;
@@ -157,9 +218,11 @@ static const contact_modes *modes_for_step(contact_model *cm, double h)
     m->sum_q = 0.0;
     for (i = 0; i < m->modes; i++) {
         const double x = h * m->b[i], beta = 2.0 * tanh(0.5 * x), mu = x > 0.0 ? beta / x : 1.0;
+        /* (1 - mu)/x, by its series x/12 - x^3/120 where 1 - mu cancels */
+        const double lag = x < 1e-3 ? x * (1.0 / 12.0 - x * x / 120.0) : (1.0 - mu) / x;
         const double d = 1.0 / (1.0 + 0.5 * beta);
         m->p[i] = m->a[i] * mu * d;
-        m->q[i] = m->p[i] * mu;
+        m->q[i] = m->p[i] * mu + 2.0 * m->a[i] * lag;
         m->sum_q += m->q[i];
         /* phi_new = keep phi + rate z over the step */
         m->keep[i] = (1.0 - 0.5 * beta) * d;
@@ -196,39 +259,41 @@ void advance_modes(contact_model *cm, double h, double z)
  * E_diss and what accepting the step needs (its length and the damper's
  * mean rate) of *out; returns the impulse of the contact force. Inlined
  * in the dashpot's and the springpot's steps below, so that the dashpot's
- * carries none of the springpot's work: `compressed` is a constant in
- * each. */
+ * carries none of the springpot's work: `springpot_damper` and
+ * `compressed` are constants in each. */
 static inline double gradient_step_of(contact_model *cm, const contact_state *in, double h, double K,
-                                      contact_state *out, const int compressed)
+                                      contact_state *out, const int springpot_damper, const int compressed)
 {
     const damper_stage d = compressed ? springpot_mean(cm, h) : (damper_stage){0.0, cm->inv_c};
     /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B */
     const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (in->v + 0.5 * h * cm->accel + d.A * d.inv_B);
-    double X, F_end;
-    const double F = mean_force(cm, K, in->x1, rho, b, &X, &F_end), z = (F - d.A) * d.inv_B;
+    double X;
+    const step_force f = mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X);
+    const double z = (f.F - d.A) * d.inv_B;
 
     carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X;
-    out->v = in->v + h * (cm->accel - cm->inv_m * F);
-    out->F = F_end;
+    out->v = in->v + h * (cm->accel - cm->inv_m * f.F);
+    out->F = f.F_end;
     out->step = h;
     out->x2_rate1 = z;
-    out->x2_rate = springpot(cm) ? z : out->F * cm->inv_c;
-    /* the damper's work F (x2' - x2): with the dashpot h F^2/c */
+    out->x2_rate = springpot_damper ? z : out->F * cm->inv_c;
     out->x2 = in->x2 + h * z;
-    out->E_diss = in->E_diss + h * F * z;
-    return h * F;
+    /* what the step dissipates: the damper's work F (x2' - x2), with the
+     * dashpot h F^2/c, and the blend's theta (X - x1)(F_end - S) >= 0 */
+    out->E_diss = in->E_diss + h * f.F * z + f.theta * (X - in->x1) * (f.F_end - f.S);
+    return h * f.F;
 }
 
 double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, 0);
+    return gradient_step_of(cm, in, h, K, out, 0, 0);
 }
 
 double gradient_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, compressed_memory(cm));
+    return gradient_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
 }
 
 const contact_method_record gradient_method = {

@@ -88,8 +88,6 @@ static double random_params(contact_params *p, double *v, double *m, int springp
     contact_default_params(p);
     p->law = 1 + (int)(3.0 * uniform());
     p->spring_exponent = uniform() < 0.5 ? (double)(2 + (int)(3.0 * uniform())) / 2.0 : 1.0 + 2.0 * uniform();
-    if (p->law == CONTACT_LAW_G1_EXTRAPOLATED)
-        p->spring_exponent = 1.0 + uniform(); /* docs/model.md §11: its stiffness falls with N while n <= 2 */
     *m = log_uniform(1e-3, 1e3);
     *v = log_uniform(1e-3, 30.0);
     p->k = log_uniform(1e5, 1e12);
@@ -151,7 +149,8 @@ static void balance(const char *what, long config, energy before, energy after, 
  * contact an advance of its fixed step, which may be shorter than dt_max
  * where that does not resolve the impact: resolution.c; out of contact
  * to the onset), each with the stiffness of its step; and the impact's
- * restitution without gravity. */
+ * restitution without gravity, where the stiffness never rises from one
+ * step to the next (the Hertz law, and the G1 law: docs/model.md §11). */
 static void test_impacts(void)
 {
     long i;
@@ -172,7 +171,8 @@ static void test_impacts(void)
             balance("impact", i, before, energy_of(&cm, &cm.s, K), cm.s.E_diss - start.E_diss, cm.s.E_diss, 0.0,
                     root_work(&cm, &start, &cm.s, cm.s.t - start.t, J));
         }
-        if (p.g == 0.0 && cm.s.impacts > 0)
+        /* law 3's stiffness may rise from one step to the next, which adds energy (docs/model.md §11) */
+        if (p.g == 0.0 && cm.s.impacts > 0 && p.law != CONTACT_LAW_G1_EXTRAPOLATED)
             CHECK(cm.s.eps <= 1.0 + ROUNDING * steps, "impact %ld: eps = %.17g", i, cm.s.eps);
         contact_release(&cm);
     }
