@@ -108,7 +108,7 @@ static step_force power_mean_force(double K, double n, double theta, double x1, 
     *X = x;
     f.S = secant_force(K, n, x1, x);
     f.F_end = K * pow(larger(x, 0.0), n);
-    f.F = f.S + theta * (f.F_end - f.S);
+    f.F = (1.0 - theta) * f.S + theta * f.F_end;
     return f;
 }
 
@@ -140,7 +140,9 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
         return 0;
     if (x1 > 0.0) {
         const double g1 = 1.0 + 0.75 * bK * s0 * (1.0 + theta), d1 = (rho - bF) / g1;
-        s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
+        const double d = d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1));
+        if (fabs(d) < 1e-2 * x1)
+            s = sqrt(x1 + d);
     }
     if (!(s > 0.0))
         s = stage_root(x1 + rho, q4, 0.0);
@@ -158,7 +160,7 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
     *X = s * s;
     f->F_end = K * s * *X;
     f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
-    f->F = f->S + theta * (f->F_end - f->S);
+    f->F = (1.0 - theta) * f->S + theta * f->F_end;
     return 1;
 }
 
@@ -185,7 +187,7 @@ static HOT_INLINE step_force mean_force(const contact_model *cm, double K, doubl
         if (*X >= 0.0) {
             f.S = 0.5 * K * (*X + x1);
             f.F_end = K * *X;
-            f.F = f.S + theta * (f.F_end - f.S);
+            f.F = (1.0 - theta) * f.S + theta * f.F_end;
             return f;
         }
     }
