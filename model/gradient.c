@@ -47,11 +47,13 @@ static double secant_force(double K, double n, double x1, double X)
 /* The step's force (docs/model.md §11): the blend
  *     F = (1 - theta) S + theta K max(X, 0)^n
  * of the discrete gradient S = secant_force and the spring's force at the
- * step's end, theta = z/(2 + z) with z = h lambda, lambda the rate at which
- * the damper relaxes the spring at the step's start. theta is O(h) where
- * the step resolves that relaxation (second order kept) and tends to 1
- * where it does not, which damps it as L-stability does instead of
- * letting the elastic indentation ring from step to step. */
+ * step's end, theta = max(0, 1 - 2/z) with z = h lambda, lambda the rate
+ * at which the damper relaxes the spring at the step's start: 0 (the
+ * discrete gradient, second order) wherever the step resolves that
+ * relaxation, z <= 2, and just enough beyond to keep the elastic
+ * indentation from overshooting its relaxed value (the linear relaxation's
+ * factor (1 - z (1 - theta)/2)/(1 + z (1 + theta)/2) is then 0), where the
+ * discrete gradient would let it ring from step to step. */
 typedef struct {
     double F, S, F_end; /* the step's force, the discrete gradient, the spring's force at X */
     double theta;
@@ -62,7 +64,7 @@ typedef struct {
 static double relaxation_weight(double h_inv_B, double stiffness)
 {
     const double z = h_inv_B * stiffness;
-    return z / (2.0 + z);
+    return z > 2.0 ? 1.0 - 2.0 / z : 0.0;
 }
 
 /* The root X of X - x1 + b F(X) = rho (b >= 0, K > 0) for any exponent and
