@@ -163,8 +163,8 @@ typedef struct {
     double *a, *b;                /* a: the block's start */
     double *phi;                  /* the modes' state: the Maxwell springs' stretch [m] */
     double h;                     /* the step length of the coefficients below (0: none yet) */
-    double sum_q;                 /* sum_i q_i */
-    double *p, *q;                /* a mu d, a mu^2 d: the mean pull's (gradient.c) */
+    double sum_q, sum_rate;       /* sum_i of the mean pull's viscous part, and of a_i rate_i */
+    double *p, *q;                /* a mu d, the mean pull's (gradient.c); a keep, the springs' after the step */
     double *keep, *rate;          /* the update */
     double radau_h; /* the step length of radau_d (0: none yet) */
     double *radau_d; /* Radau IIA's 1/(1 + h b lambda_l), five arrays (RADAU_RECIPROCAL): lambda_0's, the pairs' re, -im */

@@ -210,43 +210,61 @@ static HOT_INLINE step_force mean_force(const contact_model *cm, double K, doubl
  * = e^(-h b_i), which damps a mode far faster than the step at once) and
  * where it flows at a steady rate (phi_i = z/b_i, pulling a_i z/b_i, the
  * viscosity of a fast mode). With d_i = 1/(1 + beta_i/2) the mean pull is
- * linear in z, c_alpha (sum p_i phi_i + z h/2 sum q_i), p_i = a_i mu_i d_i,
- * q_i = p_i mu_i + 2 a_i (1 - mu_i)/(h b_i); the coefficients depend on h
- * alone and are kept for the step length last used. */
+ * linear in z, c_alpha (sum p_i phi_i + z h/2 sum_q), p_i = a_i mu_i d_i,
+ * sum_q the sum of p_i mu_i + 2 a_i (1 - mu_i)/(h b_i); the springs pull
+ * with c_alpha sum a_i phi_i' = c_alpha (sum q_i phi_i + z sum_rate) after
+ * it, q_i = a_i keep_i, sum_rate that of a_i rate_i. The coefficients
+ * depend on h alone and are kept for the step length last used. */
 static const contact_modes *modes_for_step(contact_model *cm, double h)
 {
     contact_modes *m = &cm->modes;
     size_t i;
     if (m->h == h)
         return m;
-    m->sum_q = 0.0;
+    m->sum_q = m->sum_rate = 0.0;
     for (i = 0; i < m->modes; i++) {
         const double x = h * m->b[i], beta = 2.0 * tanh(0.5 * x), mu = x > 0.0 ? beta / x : 1.0;
         /* (1 - mu)/x, by its series x/12 - x^3/120 where 1 - mu cancels */
         const double lag = x < 1e-3 ? x * (1.0 / 12.0 - x * x / 120.0) : (1.0 - mu) / x;
         const double d = 1.0 / (1.0 + 0.5 * beta);
         m->p[i] = m->a[i] * mu * d;
-        m->q[i] = m->p[i] * mu + 2.0 * m->a[i] * lag;
-        m->sum_q += m->q[i];
+        m->sum_q += m->p[i] * mu + 2.0 * m->a[i] * lag;
         /* phi_new = keep phi + rate z over the step */
         m->keep[i] = (1.0 - 0.5 * beta) * d;
         m->rate[i] = mu * h * d;
+        m->q[i] = m->a[i] * m->keep[i];
+        m->sum_rate += m->a[i] * m->rate[i];
     }
     m->h = h;
     return m;
 }
 
 /* The springpot's mean force over a step of length h as the damper of
- * the step: its memory's pull A and its viscosity 1/inv_B. */
-static damper_stage springpot_mean(contact_model *cm, double h)
+ * the step: its memory's pull A and its viscosity 1/inv_B; and in *held
+ * the part of its springs' pull after the step that is not the rate's,
+ * sum a_i keep_i phi_i. */
+static damper_stage springpot_mean(contact_model *cm, double h, double *held)
 {
     const contact_modes *m = modes_for_step(cm, h);
     const double c = cm->p.c_alpha;
-    double S = 0.0;
+    double S = 0.0, H = 0.0;
     size_t i;
-    for (i = 0; i < m->modes; i++)
+    for (i = 0; i < m->modes; i++) {
         S += m->p[i] * m->phi[i];
+        H += m->q[i] * m->phi[i];
+    }
+    *held = H;
     return (damper_stage){c * S, 1.0 / (c * (m->eta + 0.5 * h * m->sum_q))};
+}
+
+/* The springpot's rate x2' at the end of a step with the force F there and
+ * the mean rate z: its force balance F = c_alpha (eta x2' + sum a_i phi_i')
+ * with the modes after the step (the state the error-controlled steps start
+ * from must satisfy it); the mean rate where there is no lumped dashpot. */
+static double springpot_end_rate(const contact_model *cm, double F, double z, double held)
+{
+    const contact_modes *m = &cm->modes;
+    return m->eta > 0.0 ? (F / cm->p.c_alpha - (held + z * m->sum_rate)) / m->eta : z;
 }
 
 /* The modes after an accepted step of length h with the mean rate z. */
@@ -268,7 +286,8 @@ void advance_modes(contact_model *cm, double h, double z)
 static inline double gradient_step_of(contact_model *cm, const contact_state *in, double h, double K,
                                       contact_state *out, const int springpot_damper, const int compressed)
 {
-    const damper_stage d = compressed ? springpot_mean(cm, h) : (damper_stage){0.0, cm->inv_c};
+    double held = 0.0;
+    const damper_stage d = compressed ? springpot_mean(cm, h, &held) : (damper_stage){0.0, cm->inv_c};
     /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B */
     const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (in->v + 0.5 * h * cm->accel + d.A * d.inv_B);
     double X;
@@ -282,7 +301,7 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     out->F = f.F_end;
     out->step = h;
     out->x2_rate1 = z;
-    out->x2_rate = springpot_damper ? z : out->F * cm->inv_c;
+    out->x2_rate = compressed ? springpot_end_rate(cm, out->F, z, held) : springpot_damper ? z : out->F * cm->inv_c;
     out->x2 = in->x2 + h * z;
     /* what the step dissipates: the damper's work F (x2' - x2), with the
      * dashpot h F^2/c, and the blend's theta (X - x1)(F_end - S) >= 0 */

@@ -354,6 +354,7 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->h = f->h;
     t->radau_h = 0.0; /* radau_d is not copied */
     t->sum_q = f->sum_q;
+    t->sum_rate = f->sum_rate;
     if (!f->modes)
         return;
     memcpy(t->a, f->a, bytes);

@@ -612,10 +612,12 @@ def test_compressed_memory_impact_converges_to_the_full_history(fine_impacts):
     errors = impact_orders(2, fine_impacts[1], ("F_peak", "t_contact", "E_diss"), (2.5e-7, 1.25e-7, 6.25e-8))
     for key, e in errors.items():
         for i in range(2):
-            # E_diss counts the mean force times the travel: its error falls
-            # faster here (measured orders 2.53, 3.37, the last one near the
-            # reference's 1e-10), so only the floor is asserted for it.
-            high = math.inf if key == "E_diss" else 2.1
+            # E_diss counts the mean force times the travel, and the fixed
+            # step's peak force lies on its energy's exact balance: their
+            # errors fall faster here (measured orders 2.53, 3.37 for E_diss,
+            # 3.96 for F_peak, the last near the reference's 1e-10), so only
+            # the floor is asserted for them.
+            high = math.inf if key in ("E_diss", "F_peak") else 2.1
             assert 1.2 <= observed_order(e[i], e[i + 1]) <= high, (key, e)
 
 
