@@ -15,12 +15,15 @@
 
 #include "stage.h"
 
-/* The step's root inline in it: a call there costs the fixed steps more
- * than the noise (tests/instruction_counts.tsv). */
+/* The step's root inline in it, and the dashpot's step specialised (all
+ * inline, the springpot's branches gone): a call or a branch there costs
+ * the fixed steps more than the noise (tests/instruction_counts.tsv). */
 #if defined(__GNUC__)
 #define HOT_INLINE inline __attribute__((always_inline))
+#define SPECIALISED __attribute__((flatten))
 #else
 #define HOT_INLINE inline
+#define SPECIALISED
 #endif
 
 
@@ -127,8 +130,8 @@ static step_force power_mean_force(double K, double n, double theta, double x1, 
  * first two derivatives at x1 (F = K x1^(3/2), F' = 3/2 K s0, F'' = 3/4
  * K/s0; the secant's derivatives there are 1/2 and 1/3 of the force's),
  * which is off by O(d^3) and so, where the step moves x1 little, leaves
- * one Newton iteration to rounding; where that start is no root's (x1 = 0,
- * or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
+ * one Newton iteration to rounding; where that start is no good one (x1 =
+ * 0, x1 + d < 0, or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
  * (stage_root), above the root since the force is at least (q + w)/b s^3.
  * Returns 0 where the root is X < 0. */
 static inline int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
@@ -136,25 +139,25 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
 {
     const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, ws0 = w * s0, c3 = 1.0 + q * s0;
     const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = q + w;
+    /* G(s) = (((q4 s + a3) s + a2) s + c1) s + c1 s0 and its slope, by Horner */
+    const double a3 = ws0 + c3, a2 = c3 * s0, a0 = c1 * s0;
     double s = -1.0, ds;
     int i;
     if (!(c1 < 0.0))
         return 0;
     if (x1 > 0.0) {
         const double g1 = 1.0 + 0.75 * bK * s0 * (1.0 + theta), d1 = (rho - bF) / g1;
-        const double d = d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1));
-        if (fabs(d) < 1e-2 * x1)
-            s = sqrt(x1 + d);
+        s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
     }
     if (!(s > 0.0))
         s = stage_root(x1 + rho, q4, 0.0);
     for (i = 0; i < 200; i++) {
-        const double ss = s * s, t = s + s0, slope = s * (4.0 * q4 * ss + 3.0 * ws0 * s + c3 * (3.0 * s + 2.0 * s0)) + c1;
+        const double slope = ((4.0 * q4 * s + 3.0 * a3) * s + 2.0 * a2) * s + c1;
         if (!(slope > 0.0)) { /* a start below the root where G falls: from above instead */
             s = stage_root(x1 + rho, q4, 0.0);
             continue;
         }
-        ds = (ss * (q4 * ss + ws0 * s + c3 * t) + c1 * t) / slope;
+        ds = ((((q4 * s + a3) * s + a2) * s + c1) * s + a0) / slope;
         s -= ds;
         if (!(fabs(ds) > 1e-8 * s))
             break;
@@ -278,8 +281,8 @@ void advance_modes(contact_model *cm, double h, double z)
 
 /* One step of length h from *in with spring stiffness K (0: no contact:
  * free flight, exact while the damper rests). Writes t, x1, x2, v, F,
- * E_diss and what accepting the step needs (its length and the damper's
- * mean rate) of *out; returns the impulse of the contact force. Inlined
+ * E_diss, the damper's rate and what accepting a springpot's step needs
+ * (its length and the mean rate) of *out; returns the impulse of the contact force. Inlined
  * in the dashpot's and the springpot's steps below, so that the dashpot's
  * carries none of the springpot's work: `springpot_damper` and
  * `compressed` are constants in each. */
@@ -299,8 +302,10 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     out->x1 = X;
     out->v = in->v + h * (cm->accel - cm->inv_m * f.F);
     out->F = f.F_end;
-    out->step = h;
-    out->x2_rate1 = z;
+    if (springpot_damper) { /* what accepting a springpot's step needs (the dashpot's, nothing) */
+        out->step = h;
+        out->x2_rate1 = z;
+    }
     out->x2_rate = compressed ? springpot_end_rate(cm, out->F, z, held) : springpot_damper ? z : out->F * cm->inv_c;
     out->x2 = in->x2 + h * z;
     /* what the step dissipates: the damper's work F (x2' - x2), with the
@@ -309,7 +314,8 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     return h * f.F;
 }
 
-double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+SPECIALISED double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K,
+                                         contact_state *out)
 {
     return gradient_step_of(cm, in, h, K, out, 0, 0);
 }
