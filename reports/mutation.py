@@ -83,7 +83,7 @@ MUTANTS = [
     mutant("hertz-exponent", "force laws", "fixed step: the force at its end F = K x1^(3/2 + 2e-12)",
            "exponent +2e-12: F off by 2.2e-11 to 2.9e-11 at the driven test's x1 = 5e-7..2e-5 m; "
            "DRIVEN_RTOL 1e-11 (test_fmu_physics::test_driven_hertz_law_is_k_x1_to_the_3_2)",
-           (GRADIENT, "*F_end = K * s * *X;", "*F_end = K * s * *X * pow(s, 4e-12);")),
+           (GRADIENT, "f->F_end = K * s * *X;", "f->F_end = K * s * *X * pow(s, 4e-12);")),
     mutant("hertz-constant", "force laws", "k from the materials ×(1 + 3e-15)",
            "3e-15; test_contact test_hertz_constant rel 1e-15",
            (PARAMETERS, "return 4.0 / 3.0 * E_star * sqrt(R);", "return 4.0 / 3.0 * E_star * sqrt(R) * (1.0 + 3e-15);")),
@@ -144,12 +144,12 @@ MUTANTS = [
            "2e-8; test_contact test_energy_balance to rounding, "
            "test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
            "E_diss = m v0² (1 - eps²)/2 rel 1e-8",
-           (GRADIENT, "out->E_diss = in->E_diss + h * F * z;", "out->E_diss = in->E_diss + h * F * z * (1.0 + 2e-8);")),
+           (GRADIENT, "out->E_diss = in->E_diss + h * f.F * z +", "out->E_diss = in->E_diss + h * f.F * z * (1.0 + 2e-8) +")),
     mutant("gradient-secant", "time scheme", "fixed step, n = 3/2: the secant's s0³ term ×(1 + 1e-6), "
            "the mean force off its discrete gradient",
            "the spring's energy off by up to 4e-7 F dx1 a step; test_contact test_energy_balance to rounding",
-           (GRADIENT, "return 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);",
-            "return 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1 * (1.0 + 1e-6));")),
+           (GRADIENT, "f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);",
+            "f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1 * (1.0 + 1e-6));")),
     mutant("step-count", "time scheme", "H = n dt_max takes n + 1 internal steps (ceil forgives no ulp)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
            "N = 10 steps per 1 us",
