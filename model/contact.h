@@ -16,7 +16,7 @@ enum contact_law {
 };
 
 enum contact_scheme {
-    CONTACT_SCHEME_SDIRK2 = 1,  /* L-stable implicit, second order, events located (default) */
+    CONTACT_SCHEME_GRADIENT = 1, /* the implicit discrete gradient: never creates energy, second order, events located (default) */
     CONTACT_SCHEME_CENTRAL = 2  /* the paper's explicit central differences (docs/model.md §15) */
 };
 
@@ -80,7 +80,7 @@ enum contact_memory {
 /* The method a configuration runs, each in a file named for it: decided by
  * contact_method alone, and named by contact_method_name. */
 enum contact_method {
-    CONTACT_METHOD_SDIRK2 = 1,     /* fixed steps: SDIRK2 (sdirk2.c) */
+    CONTACT_METHOD_GRADIENT = 1,   /* fixed steps: the discrete gradient (gradient.c) */
     CONTACT_METHOD_ESDIRK54 = 2,   /* error-controlled steps of the dashpot, tolerance > 0: ESDIRK 5(4) (esdirk54.c) */
     CONTACT_METHOD_G1_HISTORY = 3, /* the springpot's full G1 history, BDF2 on a uniform grid (g1_history.c) */
     CONTACT_METHOD_CENTRAL = 4,    /* the paper's central differences on a uniform grid (central.c) */
@@ -138,8 +138,8 @@ typedef struct {
      * are, contact_internal.h's carry_state): what a trial step leaves for
      * accepting it, its length and the damper's rate x2' at its stages
      * before the last (x2_rate is the end's), and an error-controlled
-     * step's error over the tolerance: SDIRK2's two stages in x2_rate1 and
-     * x2_rate, a springpot's Radau IIA step's five in x2_rate1,
+     * step's error over the tolerance: a fixed step's mean rate in x2_rate1
+     * (x2_rate its end's), a springpot's Radau IIA step's five in x2_rate1,
      * x2_rate_inner and x2_rate, and its elastic indentations at the first
      * four stages (x1 is the fifth's) for its dense output. */
     double step, x2_rate1, error;
@@ -167,9 +167,9 @@ typedef struct {
     double *a, *b;                /* a: the block's start */
     double *phi;                  /* the modes' state: the Maxwell springs' stretch [m] */
     double h;                     /* the step length of the coefficients below (0: none yet) */
-    double sum_p, sum_q;          /* sum_i p_i, sum_i q_i */
-    double *p, *q;                /* a d, a d^2 b,  d = 1/(1 + gamma h b) */
-    double *keep, *rate1, *rate2; /* the update */
+    double sum_q, sum_rate;       /* sum_i of the mean pull's viscous part, and of a_i rate_i */
+    double *p, *q;                /* a mu d, the mean pull's (gradient.c); a keep, the springs' after the step */
+    double *keep, *rate;          /* the update */
     double radau_h; /* the step length of radau_d (0: none yet) */
     double *radau_d; /* Radau IIA's 1/(1 + h b lambda_l), five arrays (RADAU_RECIPROCAL): lambda_0's, the pairs' re, -im */
 } contact_modes; /* a new field: copy it in contact_copy too */
@@ -288,7 +288,7 @@ int contact_reject(char *msg, size_t len, const char *name, double value, const 
 int contact_unused_value(const contact_params *p, char *msg, size_t len);
 
 /* The method these parameters run (docs/model.md §16), and its name:
- * "sdirk2", "esdirk54", "radau_iia", "g1_history" or "central". */
+ * "gradient", "esdirk54", "radau_iia", "g1_history" or "central". */
 enum contact_method contact_method(const contact_params *p);
 const char *contact_method_name(enum contact_method method);
 
@@ -465,7 +465,7 @@ double contact_damper_rate(const contact_model *cm);
 /* Advances the model by H >= 0 to exactly t + H by the method of
  * contact_method. Out of contact free flight is one exact step (while a
  * springpot recovers, steps growing with the time since separation). In
- * contact SDIRK2 takes equal steps of at most contact_step_limit (shorter
+ * contact the discrete gradient takes equal steps of at most contact_step_limit (shorter
  * where that would not resolve the impact: CONTACT_REFINED), ESDIRK 5(4)
  * the steps its controller chooses for the tolerance, at most
  * contact_step_limit; both locate contact onset and separation within a

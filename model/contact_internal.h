@@ -19,7 +19,7 @@ double memory_kernel_floor(const contact_params *p);
 /* A method's record, one const at the end of the method's own file, as
  * GSL's gsl_odeiv2_step_type: what the evolve loop, the events and the
  * resolution checks ask of a method. contact_configure chooses it once
- * (method_record); out of contact every method takes the damper's SDIRK2
+ * (method_record); out of contact every method takes the damper's fixed
  * steps (free flight, a springpot's recovery). */
 typedef double (*contact_trial_step)(contact_model *cm, const contact_state *in, double h, double K,
                                      contact_state *out);
@@ -49,9 +49,9 @@ struct contact_method_record {
     int (*grid_step)(contact_model *cm, double h, double *impulse, unsigned stop_at);
 };
 
-/* The records, at the ends of sdirk2.c, esdirk54.c, radau_iia.c,
+/* The records, at the ends of gradient.c, esdirk54.c, radau_iia.c,
  * g1_history.c and central.c. */
-extern const contact_method_record sdirk2_method, esdirk54_method, radau_iia_method, g1_history_method,
+extern const contact_method_record gradient_method, esdirk54_method, radau_iia_method, g1_history_method,
     central_method;
 
 /* method.c */
@@ -64,12 +64,12 @@ void resolve_contact(contact_model *cm);
 /* model.c */
 int memory_at_rest(const contact_model *cm);
 
-/* sdirk2.c: SDIRK2's step of length h from *in with spring stiffness K
- * into *out, returning the contact force's impulse, by the damper
- * (sdirk_step below). */
-double sdirk_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
-double sdirk_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
-void advance_modes(contact_model *cm, double h, double z1, double z2);
+/* gradient.c: the fixed step of length h from *in with spring stiffness
+ * K into *out, returning the contact force's impulse, by the damper
+ * (fixed_step below). */
+double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+double gradient_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out);
+void advance_modes(contact_model *cm, double h, double z);
 
 /* radau_iia.c, its record's step, memory and dense output (the tests take
  * them one by one). */
@@ -114,11 +114,11 @@ static inline int compressed_memory(const contact_model *cm)
     return springpot(cm) && cm->p.memory == CONTACT_MEMORY_COMPRESSED;
 }
 
-/* SDIRK2's step (sdirk2.c), the damper's own: inline, so that the fixed
- * steps call the one they take. */
-static inline double sdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+/* The fixed step (gradient.c), the damper's own: inline, so that the
+ * fixed steps call the one they take. */
+static inline double fixed_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return springpot(cm) ? sdirk_springpot_step(cm, in, h, K, out) : sdirk_dashpot_step(cm, in, h, K, out);
+    return springpot(cm) ? gradient_springpot_step(cm, in, h, K, out) : gradient_dashpot_step(cm, in, h, K, out);
 }
 
 static inline int full_history(const contact_model *cm)
@@ -164,11 +164,11 @@ static inline contact_trial_step method_step(const contact_model *cm)
 }
 
 /* A trial step from *in: the method's in contact; out of contact every
- * method takes SDIRK2's (a recovering springpot's steps, and the onset
- * search among them). */
+ * method takes the fixed step (a recovering springpot's steps, and the
+ * onset search among them). */
 static inline double trial_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return in->in_contact ? method_step(cm)(cm, in, h, K, out) : sdirk_step(cm, in, h, K, out);
+    return in->in_contact ? method_step(cm)(cm, in, h, K, out) : fixed_step(cm, in, h, K, out);
 }
 
 static inline double indentation_rate(const contact_model *cm, const contact_state *s)
@@ -205,21 +205,21 @@ static inline void carry_state(contact_state *to, const contact_state *from)
     memcpy(to, from, offsetof(contact_state, step));
 }
 
-/* What accepting an SDIRK2 step makes of the memory (its record's
- * accept): the compressed memory's modes follow its stages. */
-static inline void sdirk2_accept(contact_model *cm, const contact_state *trial)
+/* What accepting a fixed step makes of the memory (its record's accept):
+ * the compressed memory's modes follow its mean rate. */
+static inline void gradient_accept(contact_model *cm, const contact_state *trial)
 {
     if (compressed_memory(cm))
-        advance_modes(cm, trial->step, trial->x2_rate1, trial->x2_rate);
+        advance_modes(cm, trial->step, trial->x2_rate1);
 }
 
-/* Makes an SDIRK2 trial step the model's state, and its memory follow:
- * inline, for the fixed steps split at events (SDIRK2's alone) and every
- * method's steps out of contact; calls through the record there cost the
- * fixed steps more than the noise (tests/instruction_counts.tsv). */
-static inline void accept_sdirk2_step(contact_model *cm, const contact_state *trial)
+/* Makes a fixed trial step the model's state, and its memory follow:
+ * inline, for the fixed steps split at events and every method's steps
+ * out of contact; calls through the record there cost the fixed steps
+ * more than the noise (tests/instruction_counts.tsv). */
+static inline void accept_fixed_step(contact_model *cm, const contact_state *trial)
 {
-    sdirk2_accept(cm, trial);
+    gradient_accept(cm, trial);
     carry_state(&cm->s, trial);
 }
 

@@ -127,8 +127,8 @@ double onset_step(const contact_model *cm)
 
 /* While a springpot's dent recovers in free flight, its memory relaxes on
  * the time scale of the time since separation: steps of a fraction f of it
- * (at least dt_max), O(log) many however long the flight. SDIRK2's error in
- * the recovery is O(f^2), so f shrinks with dt_max, f = RECOVERY_STEPS
+ * (at least dt_max), O(log) many however long the flight. The fixed step's
+ * error in the recovery is O(f^2), so f shrinks with dt_max, f = RECOVERY_STEPS
  * dt_max / t_contact (at most 1/16), for an error of O(dt_max^2) like the
  * contact's. */
 #define RECOVERY_STEPS 64.0

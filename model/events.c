@@ -48,8 +48,8 @@ void touch(contact_model *cm)
 void fly(contact_model *cm, double tau, int touches)
 {
     contact_state trial;
-    sdirk_step(cm, &cm->s, tau, 0.0, &trial);
-    accept_sdirk2_step(cm, &trial);
+    fixed_step(cm, &cm->s, tau, 0.0, &trial);
+    accept_fixed_step(cm, &trial);
     if (touches)
         touch(cm);
 }
@@ -290,21 +290,21 @@ void end_contact(contact_state *s, double t, double v)
     s->in_contact = 0;
 }
 
-/* Out of contact for up to h while a springpot's dent recovers: an SDIRK
+/* Out of contact for up to h while a springpot's dent recovers: a fixed
  * step with no spring, cut at the onset if the striker meets the surface.
  * Returns the length stepped, and whether contact began. */
 double recover(contact_model *cm, double h, int *touches)
 {
     contact_state trial;
     double J;
-    sdirk_step(cm, &cm->s, h, 0.0, &trial);
+    fixed_step(cm, &cm->s, h, 0.0, &trial);
     *touches = trial.x1 > 0.0;
     if (*touches && cm->s.x1 < 0.0)
         h = event_time(cm, &cm->s, h, 0.0, gap, -trial.x1, 1e-15, -1.0, &trial, &J);
     else if (*touches) /* it starts on the surface: contact at once */
         h = 0.0;
     if (h > 0.0)
-        accept_sdirk2_step(cm, &trial);
+        accept_fixed_step(cm, &trial);
     if (*touches)
         touch(cm);
     return h;

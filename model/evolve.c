@@ -13,14 +13,14 @@
  * a diverging state could reach it. */
 #define MAX_EVENTS_PER_STEP 1000
 
-/* One SDIRK2 step of length h, split at contact onset and separation (the
- * fixed steps split at events are SDIRK2's alone, so its step and accept
- * are taken inline here, not through its record). Returns 0, 1 when it
+/* One fixed step of length h, split at contact onset and separation (the
+ * fixed steps split at events are gradient.c's alone, so its step and
+ * accept are taken inline here, not through its record). Returns 0, 1 when it
  * stopped early at an event of the mask stop_at (the state's time tells
  * where), or -1 when the events do not end (a diverging state). Inline, as
  * the controlled step below: contact_advance_until's loop takes one at
  * every internal step, and a call costs speed there. */
-static inline int sdirk_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
+static inline int fixed_internal_step(contact_model *cm, double h, double *impulse, unsigned stop_at)
 {
     contact_state *s = &cm->s, trial;
     int events;
@@ -43,14 +43,14 @@ static inline int sdirk_internal_step(contact_model *cm, double h, double *impul
             continue;
         }
         K = spring_stiffness(cm, s->n + 1);
-        J = sdirk_step(cm, s, h, K, &trial);
+        J = fixed_step(cm, s, h, K, &trial);
         /* Separation is x1 falling to 0 on the way out: an indentation too
          * small for a double (x1 = v h underflows at v ~ 1e-317) is not one. */
         separates = !(trial.x1 > 0.0) && !(indentation_rate(cm, &trial) > 0.0);
         if (separates)
             tau = locate_separation(cm, s, h, K, &trial, &J);
         peak = peak_force_within(cm, s, tau, K, &trial);
-        accept_sdirk2_step(cm, &trial);
+        accept_fixed_step(cm, &trial);
         count_contact_step(s, peak);
         *impulse += J;
         if (!separates)
@@ -120,7 +120,7 @@ static int internal_step(contact_model *cm, double h, double *impulse, unsigned 
     cm->s.steps++;
     if (cm->method->grid_step)
         return cm->method->grid_step(cm, h, impulse, stop_at);
-    return sdirk_internal_step(cm, h, impulse, stop_at);
+    return fixed_internal_step(cm, h, impulse, stop_at);
 }
 
 /* Whether every value of the state is finite, one by one. */

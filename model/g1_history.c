@@ -47,7 +47,7 @@ static int g1_contact_events(contact_model *cm, const contact_state *before, uns
         begin_contact(s, t, v);
     if (s->F > 0.0)
         count_contact_step(s, s->F);
-    /* as the SDIRK path: a contact ends with the indentation falling, not
+    /* as the fixed steps: a contact ends with the indentation falling, not
      * while the striker still moves in and x1 rounds to 0 */
     if (before->in_contact && s->in_contact && !(s->F > 0.0) && !(s->v - s->x2_rate > 0.0))
         end_contact(s, t, v);

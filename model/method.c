@@ -2,7 +2,7 @@
  * §16): the springpot's full G1 history steps by its own BDF2 scheme, the
  * central scheme by the paper's central differences, error-controlled steps
  * by ESDIRK 5(4) (the dashpot) or Radau IIA (the compressed springpot),
- * fixed ones by SDIRK2; each method's record lies at the end of its file. */
+ * fixed ones by the discrete gradient (gradient.c); each method's record lies at the end of its file. */
 #include <math.h>
 #include <stddef.h>
 
@@ -24,14 +24,14 @@ const contact_method_record *method_record(const contact_params *p)
         return &central_method;
     if (p->tolerance > 0.0 && !law_counts_steps(p))
         return p->damper == CONTACT_DAMPER_SPRINGPOT ? &radau_iia_method : &esdirk54_method;
-    return &sdirk2_method;
+    return &gradient_method;
 }
 
 enum contact_method contact_method(const contact_params *p) { return method_record(p)->method; }
 
 const char *contact_method_name(enum contact_method method)
 {
-    static const contact_method_record *const records[] = {&sdirk2_method, &esdirk54_method, &radau_iia_method,
+    static const contact_method_record *const records[] = {&gradient_method, &esdirk54_method, &radau_iia_method,
                                                             &g1_history_method, &central_method};
     size_t i;
     for (i = 0; i < sizeof records / sizeof records[0]; i++)

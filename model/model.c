@@ -28,7 +28,7 @@ static int kernel_fits(const contact_kernel *k, const contact_params *p)
 }
 
 /* The arrays of the compressed memory's block, one after another. */
-#define MODE_ARRAYS 13
+#define MODE_ARRAYS 12
 
 /* The block's arrays for `modes` modes, padded to whole lanes: the block
  * kept where it holds them, a new one replacing it otherwise, its values
@@ -52,9 +52,8 @@ static int reserve_modes(contact_modes *m, size_t modes)
     m->p = block + 3 * room;
     m->q = block + 4 * room;
     m->keep = block + 5 * room;
-    m->rate1 = block + 6 * room;
-    m->rate2 = block + 7 * room;
-    m->radau_d = block + 8 * room;
+    m->rate = block + 6 * room;
+    m->radau_d = block + 7 * room;
     return 0;
 }
 
@@ -128,8 +127,7 @@ static void modes_at_rest(contact_modes *m)
     memset(m->p, 0, bytes);
     memset(m->q, 0, bytes);
     memset(m->keep, 0, bytes);
-    memset(m->rate1, 0, bytes);
-    memset(m->rate2, 0, bytes);
+    memset(m->rate, 0, bytes);
 }
 
 int contact_configure(contact_model *cm, const contact_params *p)
@@ -355,8 +353,8 @@ void contact_copy(contact_model *to, const contact_model *from)
     t->eta = f->eta;
     t->h = f->h;
     t->radau_h = 0.0; /* radau_d is not copied */
-    t->sum_p = f->sum_p;
     t->sum_q = f->sum_q;
+    t->sum_rate = f->sum_rate;
     if (!f->modes)
         return;
     memcpy(t->a, f->a, bytes);
@@ -365,8 +363,7 @@ void contact_copy(contact_model *to, const contact_model *from)
     memcpy(t->p, f->p, bytes);
     memcpy(t->q, f->q, bytes);
     memcpy(t->keep, f->keep, bytes);
-    memcpy(t->rate1, f->rate1, bytes);
-    memcpy(t->rate2, f->rate2, bytes);
+    memcpy(t->rate, f->rate, bytes);
     pad_modes(t);
 }
 

@@ -113,8 +113,8 @@ int contact_check_params(const contact_params *p, char *msg, size_t len)
                       "the number of G1 intervals must be >= 0 (0 = internal steps since contact onset)");
     if (p->scene != CONTACT_SCENE_DROP && p->scene != CONTACT_SCENE_DRIVEN)
         return contact_reject(msg, len, "scene", p->scene, "1 = drop test, 2 = driven");
-    if (p->scheme != CONTACT_SCHEME_SDIRK2 && p->scheme != CONTACT_SCHEME_CENTRAL)
-        return contact_reject(msg, len, "scheme", p->scheme, "1 = implicit SDIRK2, 2 = the paper's central differences");
+    if (p->scheme != CONTACT_SCHEME_GRADIENT && p->scheme != CONTACT_SCHEME_CENTRAL)
+        return contact_reject(msg, len, "scheme", p->scheme, "1 = the implicit discrete gradient, 2 = the paper's central differences");
     if (p->damper != CONTACT_DAMPER_DASHPOT && p->damper != CONTACT_DAMPER_SPRINGPOT)
         return contact_reject(msg, len, "damper", p->damper, "1 = dashpot, 2 = springpot");
     if (!(p->damper_order > 0.0 && p->damper_order <= 1.0))

@@ -18,7 +18,7 @@ int contact_me_check(const contact_params *p, char *msg, size_t len)
         return contact_reject(msg, len, "memory", p->memory,
                               "Model Exchange takes the springpot's compressed memory, memory = 2 (its modes are "
                               "ODEs): the full G1 memory (memory = 1) is discrete-time, take co-simulation for it");
-    if (p->scheme != CONTACT_SCHEME_SDIRK2)
+    if (p->scheme != CONTACT_SCHEME_GRADIENT)
         return contact_reject(msg, len, "scheme", p->scheme,
                               "Model Exchange has the host's solver integrate the model: the central-difference "
                               "scheme (scheme = 2) is a discrete-time method, take scheme = 1 or co-simulation");

@@ -1,5 +1,5 @@
 /* Whether fixed steps resolve an impact: the time a striker takes to stop,
- * the uniform grids' check of dt_max against it, the warning where SDIRK2's
+ * the uniform grids' check of dt_max against it, the warning where the
  * fixed steps are refined in contact, the fixed step of a contact, and the
  * check that an advance takes no more steps than a caller allows. */
 #include <math.h>
@@ -12,9 +12,7 @@
  * the elastic impact's largest indentation (docs/model.md §2), or where a load
  * a > 0 presses the striker in, sqrt(x_a / a) with x_a = (a / (K inv_m))^(1/n)
  * its indentation at rest under it: the shorter. A step much longer sees the
- * striker stopped and thrown back within it, and the stages of a step that
- * holds a whole impact give back more than it brought (eps = sqrt(2) as the
- * mass vanishes). INFINITY without inertia (inv_m = 0) or either. */
+ * striker stopped and thrown back within it. INFINITY without inertia (inv_m = 0) or either. */
 static double turnaround_time(double n, double K, double inv_m, double v, double a)
 {
     double t = INFINITY;
@@ -170,10 +168,9 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
 /* The fixed step in the current contact: dt_max where it resolves the
  * impact (CONTACT_RESOLUTION steps in its turnaround time) or the method
  * does not refine its steps, else CONTACT_REFINED steps in that time: a step that does not
- * resolve it is no one's choice, and a barely resolved one would show
- * SDIRK2's gain of energy in nearly elastic impacts, which grows with the
- * step like (h/t_c)^2.5 (docs/stability.md). Set where the onset speed or
- * the inertia change. */
+ * resolve it is no one's choice, and a barely resolved one errs by
+ * O((h/t_c)^2) of order one (docs/stability.md). Set where the onset speed
+ * or the inertia change. */
 void resolve_contact(contact_model *cm)
 {
     const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);

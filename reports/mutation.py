@@ -72,18 +72,18 @@ def mutant(name, category, change, claim, *edits):
 G1, MODEL, STATE, INSTANCE = \
     "model/g1.c", "fmu_src/binding/fmu_model.c", "fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmu_instance.c"
 # The model's files (model/): one responsibility each.
-PARAMETERS, LIFE, STAGE, SDIRK2, RADAU, EVENTS, EVOLVE, PASSIVITY = ("model/" + f for f in (
-    "parameters.c", "model.c", "stage.h", "sdirk2.c", "radau_iia.c", "events.c", "evolve.c", "passivity.c"))
+PARAMETERS, LIFE, GRADIENT, RADAU, EVENTS, EVOLVE, PASSIVITY = ("model/" + f for f in (
+    "parameters.c", "model.c", "gradient.c", "radau_iia.c", "events.c", "evolve.c", "passivity.c"))
 CONTACT_H = "model/contact.h"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
 
 MUTANTS = [
     # ------------------------------------------------------------ force laws
-    mutant("hertz-exponent", "force laws", "implicit stage: F = K x1^(3/2 + 2e-12)",
+    mutant("hertz-exponent", "force laws", "fixed step: the force at its end F = K x1^(3/2 + 2e-12)",
            "exponent +2e-12: F off by 2.2e-11 to 2.9e-11 at the driven test's x1 = 5e-7..2e-5 m; "
            "DRIVEN_RTOL 1e-11 (test_fmu_physics::test_driven_hertz_law_is_k_x1_to_the_3_2)",
-           (STAGE, "return K * s * *X;", "return K * s * *X * pow(s, 4e-12);")),
+           (GRADIENT, "f->F_end = K * s * *X;", "f->F_end = K * s * *X * pow(s, 4e-12);")),
     mutant("hertz-constant", "force laws", "k from the materials ×(1 + 3e-15)",
            "3e-15; test_contact test_hertz_constant rel 1e-15",
            (PARAMETERS, "return 4.0 / 3.0 * E_star * sqrt(R);", "return 4.0 / 3.0 * E_star * sqrt(R) * (1.0 + 3e-15);")),
@@ -127,23 +127,29 @@ MUTANTS = [
             "- pow(2.0 * delta, -alpha) * (1.0 + 4e-13) * weighted_history(w, f, n, 2);")),
     mutant("g1-N-off-by-one", "G1 weights and sums", "the G1 law counts N = steps since onset + 2 (not + 1)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error, DRIVEN_RTOL 1e-11",
-           (EVOLVE, "K = spring_stiffness(cm, s->n + 1);\n        J = sdirk_step(",
-            "K = spring_stiffness(cm, s->n + 2);\n        J = sdirk_step(")),
+           (EVOLVE, "K = spring_stiffness(cm, s->n + 1);\n        J = fixed_step(",
+            "K = spring_stiffness(cm, s->n + 2);\n        J = fixed_step(")),
     # ------------------------------------------------------------ time scheme
-    mutant("sdirk-gamma", "time scheme", "SDIRK γ = (1 - 1/√2)(1 + 1e-4): first order",
-           "measured: per-impact figures off by 1.5e-7 from the GSL reference; "
-           "test_solver::test_per_impact_figures_against_the_reference rel 1e-7",
-           (SDIRK2, "#define SDIRK_GAMMA 0.29289321881345248",
-            "#define SDIRK_GAMMA (0.29289321881345248 * (1.0 + 1e-4))")),
-    mutant("sdirk-impulse-weight", "time scheme", "the step's impulse h((1-γ)F1 + γ F2(1 + 1e-11)), which moves x2",
-           "x2 off by ~3e-12; momentum identity x2 = m v0 (1 + eps)/c rel 1e-12 (test_contact, "
+    mutant("gradient-trapezoid", "time scheme", "fixed step: the position's trapezoid weighs the velocity's "
+           "change by 1/2 (1 + 1e-6)",
+           "energy created 1e-6 h² F²/m a step, about 1e-12 of the impact's energy over an impact at 1e-7 s; "
+           "test_contact test_energy_balance to rounding (13 000 steps: 1.2e-11) and test_energy's every step",
+           (GRADIENT, "const double b = h * (d.inv_B + 0.5 * h * cm->inv_m),",
+            "const double b = h * (d.inv_B + 0.5 * (1.0 + 1e-6) * h * cm->inv_m),")),
+    mutant("gradient-flow", "time scheme", "fixed step: the dent moves by h z (1 + 1e-11)",
+           "x2 off by ~1e-11; momentum identity x2 = m v0 (1 + eps)/c rel 1e-12 (test_contact, "
            "test_fmu_physics::test_drop_momentum_identity)",
-           (SDIRK2, "impulse = hb * F1 + hg * F2;", "impulse = hb * F1 + hg * F2 * (1.0 + 1e-11);")),
-    mutant("sdirk-dissipation", "time scheme", "each step's dissipation J²/(c h) ×(1 + 2e-8)",
-           "2e-8; test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
+           (GRADIENT, "out->x2 = in->x2 + h * z;", "out->x2 = in->x2 + h * z * (1.0 + 1e-11);")),
+    mutant("gradient-dissipation", "time scheme", "each step's dissipation h F z ×(1 + 2e-8)",
+           "2e-8; test_contact test_energy_balance to rounding, "
+           "test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
            "E_diss = m v0² (1 - eps²)/2 rel 1e-8",
-           (SDIRK2, "impulse * impulse * cm->inv_c / h : 0.0);",
-            "impulse * impulse * cm->inv_c / h * (1.0 + 2e-8) : 0.0);")),
+           (GRADIENT, "out->E_diss = in->E_diss + h * f.F * z +", "out->E_diss = in->E_diss + h * f.F * z * (1.0 + 2e-8) +")),
+    mutant("gradient-secant", "time scheme", "fixed step, n = 3/2: the secant's s0³ term ×(1 + 1e-6), "
+           "the mean force off its discrete gradient",
+           "the spring's energy off by up to 4e-7 F dx1 a step; test_contact test_energy_balance to rounding",
+           (GRADIENT, "f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);",
+            "f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1 * (1.0 + 1e-6));")),
     mutant("step-count", "time scheme", "H = n dt_max takes n + 1 internal steps (ceil forgives no ulp)",
            STRUCTURAL + "; test_fmu_physics::test_driven_g1_law_has_the_straight_line_error counts "
            "N = 10 steps per 1 us",

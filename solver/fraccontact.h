@@ -81,7 +81,7 @@ FC_API int fc_params_warning(const fc_params *p, char *msg, size_t len);
 FC_API int fc_error_controlled(const fc_params *p);
 
 /* The method the run takes, as the model names it (contact_method_name):
- * "sdirk2", "esdirk54", "radau_iia", "g1_history" or "central". */
+ * "gradient", "esdirk54", "radau_iia", "g1_history" or "central". */
 FC_API const char *fc_method_name(const fc_params *p);
 
 /* The largest internal step of these parameters [s]: dt_max, or for

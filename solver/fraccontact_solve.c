@@ -179,7 +179,7 @@ static void usage(const option_table *t)
            "  impacts      finished impacts\n"
            "  steps        internal steps (the reference: right-hand-side evaluations)\n"
            "  cpu_seconds  of the solve alone (the median over --repeat)\n"
-           "  method, k    sdirk2, esdirk54 or radau_iia (error-controlled steps, tolerance > 0: the dashpot's,\n"
+           "  method, k    gradient, esdirk54 or radau_iia (error-controlled steps, tolerance > 0: the dashpot's,\n"
            "               the springpot's), central, g1_history (a springpot's full G1 history) or\n"
            "               reference; the spring constant used [N/m^n]\n"
            "  params       every parameter of the run, by the FMU's names\n"

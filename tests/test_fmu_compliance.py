@@ -22,7 +22,7 @@ def test_validate_fmu_finds_no_problem(fmu_path):
 def test_fmu_contents(fmu_path):
     names = set(zipfile.ZipFile(fmu_path).namelist())
     assert {"modelDescription.xml", "binaries/linux64/fraccontact.so"} <= names
-    assert {f"sources/{f}" for f in ("g1.c", "sdirk2.c", "esdirk54.c", "radau_iia.c", "evolve.c", "fmu_model.c",
+    assert {f"sources/{f}" for f in ("g1.c", "gradient.c", "esdirk54.c", "radau_iia.c", "evolve.c", "fmu_model.c",
                                      "fmi2_cosim.c", "guid.h")} <= names
 
 

@@ -3,7 +3,7 @@
 (fc_method_name) and the package (Run.method) report that name. Every
 configuration class maps to the method the rules of §16 give it, and the
 steps taken show that method ran: the uniform grids step through the
-flight to the specimen one dt_max at a time, SDIRK2 flies in one exact
+flight to the specimen one dt_max at a time, the fixed steps fly in one exact
 step and then takes fixed steps in contact, ESDIRK 5(4) and Radau IIA
 take the few steps their controller allows."""
 
@@ -30,15 +30,15 @@ GRID_STEPS = round(T_END / DT)
 
 SPRINGPOT = dict(damper="springpot")
 CLASSES = [  # (parameters, the method docs/model.md §16 gives them)
-    (dict(law=1), "sdirk2"),
-    (dict(law=2), "sdirk2"),
-    (dict(law=3), "sdirk2"),
+    (dict(law=1), "gradient"),
+    (dict(law=2), "gradient"),
+    (dict(law=3), "gradient"),
     (dict(law=2, tolerance=1e-6), "esdirk54"),
     (dict(law=1, g1_nodes=100, tolerance=1e-6), "esdirk54"),
-    (dict(law=1, tolerance=1e-6), "sdirk2"),  # g1_nodes = 0 counts steps: fixed steps
+    (dict(law=1, tolerance=1e-6), "gradient"),  # g1_nodes = 0 counts steps: fixed steps
     (dict(scheme="central"), "central"),
     (dict(scheme="central", law=2, tolerance=1e-6), "central"),
-    (dict(SPRINGPOT, memory="compressed"), "sdirk2"),
+    (dict(SPRINGPOT, memory="compressed"), "gradient"),
     (dict(SPRINGPOT, memory="compressed", law=2, tolerance=1e-6), "radau_iia"),
     (dict(SPRINGPOT, memory="compressed", law=1, g1_nodes=100, tolerance=1e-6), "radau_iia"),
     (dict(SPRINGPOT, memory="full"), "g1_history"),
@@ -67,7 +67,7 @@ def test_each_configuration_runs_its_named_method(params, method):
     assert r.method == method
     if method in ("central", "g1_history"):  # the grid throughout, flight included
         assert r.steps == GRID_STEPS
-    elif method == "sdirk2":  # one step of flight, then fixed steps of dt_max in contact
+    elif method == "gradient":  # one step of flight, then fixed steps of dt_max in contact
         flight = GAP0 / 0.626418
         assert abs(r.steps - 1 - (T_END - flight) / DT) <= 1
     else:  # the controller's steps: far fewer than fixed steps would take

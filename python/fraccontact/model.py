@@ -11,7 +11,7 @@ co-simulation inputs a, a2 and coupling are no parameters of a run
 them, broadcast together. An integer parameter takes a whole number (2 or
 2.0, not 2.5 or True), and an enumerated one also the words of the solver's
 --help and the FMU's modelDescription: law g1/hertz/g1x, scene drop/driven,
-scheme sdirk2/central, damper dashpot/springpot, memory full/compressed.
+scheme gradient/central, damper dashpot/springpot, memory full/compressed.
 A bad value raises ValueError naming the parameter, its value and the rule
 (in a batch, the case's index too); a value without effect (E_s beside a
 given k, damper_order with the dashpot) warns (ParameterWarning) with the
@@ -32,7 +32,7 @@ scipy's OptimizeResult.
              stopped: why, "impacts", "t_end" or "receding";
              impacts, steps, k: finished impacts, internal steps, the spring
                constant used;
-             method: the method that ran, as the model names it (sdirk2,
+             method: the method that ran, as the model names it (gradient,
                esdirk54, radau_iia, g1_history, central; docs/model.md §16).
   Series   what simulate() returns: the columns t, F, x, x1, x2, v, E_diss
            (arrays, SI units), and run, the Run impact() gives for the same
@@ -332,7 +332,7 @@ class Run(_Record):
     impacts: int      # finished impacts
     steps: int        # internal steps
     k: float          # the spring constant used (given, or derived) [N/m^n]
-    method: str       # the method that ran: sdirk2, esdirk54, radau_iia, g1_history or central
+    method: str       # the method that ran: gradient, esdirk54, radau_iia, g1_history or central
 
 
 @dataclass

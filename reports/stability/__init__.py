@@ -10,7 +10,7 @@ compressed one), runs of 1e6 steps and repeated impacts under gravity with
 the dent recovering between them (stability/springpot.py).
 
 Each dashpot case runs three ways: the G1 law and the Hertz law with fixed
-SDIRK2 steps of the case's dt (tolerance = 0), and "adaptive", the Hertz
+discrete-gradient steps of the case's dt (tolerance = 0), and "adaptive", the Hertz
 law with error-controlled steps (tolerance = 1e-6, Kvaerno's ESDIRK 5(4))
 capped by the case's dt (so dt = 1e-2 caps them far beyond the contact
 time). Every dashpot run is checked for what holds at any step (finite, no

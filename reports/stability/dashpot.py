@@ -1,5 +1,5 @@
 """The dashpot's study: a matrix of cases from the paper's h20 test, each run
-with the G1 law and the Hertz law in fixed SDIRK2 steps and "adaptive" (the
+with the G1 law and the Hertz law in fixed discrete-gradient steps and "adaptive" (the
 Hertz law, error-controlled steps), every run checked for what holds at any
 step and against the GSL reference at the scheme's own error; and the
 convergence study that measures the constants those tolerances use."""
@@ -21,13 +21,13 @@ QUANTITIES = ("F_peak", "eps", "t_contact", "x2", "E_diss", "v")
 # for F_peak and E_diss and t_c for the rest (see scales(), time_scale()).
 # Errors: F_peak, t_contact, x2 and E_diss relative, eps absolute, v (at the end)
 # over the impact speed.
-# SDIRK2 is second order: C2 is twice the largest error / (dt/T)^2 the
+# The fixed step is second order: C2 is twice the largest error / (dt/T)^2 the
 # convergence study measures over every regime and every dt from T/20 to
 # T/640 (docs/stability.md, "Convergence study"; the regimes' constants
 # differ by orders of magnitude, so the tolerance is tight for some cases
 # and loose for others, the stiff ones above all: the report lists each
 # run's error over its tolerance).
-C2 = dict(F_peak=0.3, eps=0.62, t_contact=1.0, x2=1.2, E_diss=3.6, v=0.62)
+C2 = dict(F_peak=0.5, eps=1.3, t_contact=2.1, x2=2.4, E_diss=4.4, v=1.3)
 # The G1 law with N = n steps since onset is Hertz with the stiffness
 # k (1 + 3/(8n) + O(n^-2)) (docs/model.md §4): at time t the relative error is
 # 3 dt / (8 t), a first-order error in dt/T. For the elastic peak force,
@@ -39,34 +39,24 @@ D1 = dict(F_peak=0.55, eps=1.2, t_contact=0.82, x2=1.9, E_diss=1.7, v=1.2)
 # the solve at rtol 1e-12 (the error of either scales with rtol: the distance
 # is about 10 times the error of the rtol 1e-13 solve).
 REF_RTOLS = (1e-13, 1e-12)
-# Known findings: (case, law) -> the checks that fail there. They are
-# properties of the model's time scheme, reported in docs/stability.md with
-# dashpot_report.FINDINGS, not allowances: a run listed here must still fail
-# exactly these checks (a fix shows up as a failure of this script: remove
-# the entry), and a run not listed must pass every check.
+# Known findings: (case, law) -> the checks that fail there, properties of
+# the time scheme reported in docs/stability.md, not allowances: a run
+# listed here must still fail exactly these checks (a fix shows up as a
+# failure of this script: remove the entry), and a run not listed must pass
+# every check. The fixed step never creates energy (docs/model.md §11), so
+# none is listed.
 FORCE = "F <= c v_max"
 CHECKS = ("finite", "no tension", EPS, "momentum", ENERGY, FORCE, "reference")
-_ENERGY_RUNS = [("c = 1e+07", "hertz"), ("c = 1e+09", "hertz"), ("m = 0.001", "hertz"),
-                ("corner c 1e+09, E_s 1e+06, v0 0.0001, m 1000, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 1e+06, v0 0.0001, m 0.001, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 1e+06, v0 30, m 0.001, dt 1e-07", "hertz"),
-                ("corner c 1e+09, E_s 1e+06, v0 30, m 0.001, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 1e-07", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 0.001, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 0.0001, m 1000, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 30, m 0.001, dt 0.01", "hertz"),
-                ("corner c 1e+09, E_s 2.1e+11, v0 30, m 1000, dt 0.01", "hertz")]
-_ENERGY_EPS_RUNS = [("corner c 1e+09, E_s 1e+06, v0 30, m 1000, dt 0.01", "hertz"),
-                    ("corner c 1e+09, E_s 2.1e+11, v0 30, m 0.001, dt 1e-07", "hertz")]
-_FORCE_CASES = ["corner c 0.01, E_s 1e+06, v0 0.0001, m 0.001, dt 0.01",
-                "corner c 0.01, E_s 1e+06, v0 0.0001, m 1000, dt 0.01",
-                "corner c 0.01, E_s 1e+06, v0 30, m 1000, dt 0.01",
-                "corner c 0.01, E_s 2.1e+11, v0 0.0001, m 1000, dt 0.01",
-                "corner c 0.01, E_s 2.1e+11, v0 30, m 0.001, dt 1e-07",
-                "corner c 0.01, E_s 2.1e+11, v0 30, m 1000, dt 1e-07",
-                "corner c 0.01, E_s 2.1e+11, v0 30, m 1000, dt 0.01"]
-KNOWN = {**{run: {ENERGY} for run in _ENERGY_RUNS}, **{run: {ENERGY, EPS} for run in _ENERGY_EPS_RUNS},
-         **{(case, law): {FORCE} for case in _FORCE_CASES for law in ("g1", "hertz")}}
+KNOWN = {}
+# The force's bound of a fixed step: n + 1 times the model's c v_max. The
+# step's mean force F exceeds c v only where x1 falls over the step, so it
+# stays below the larger of c v_max and the force at the step's start, and
+# the spring's force at its end is at most n + 1 times the mean where x1
+# rises (docs/model.md §11): across a dashpot too stiff for the step the
+# elastic indentation rings about its quasi-static value, and the force at
+# the steps' ends with it, while the mean force, which moves the striker,
+# stays that of the dashpot.
+FIXED_FORCE = H20["spring_exponent"] + 1.0
 # The adaptive variant: law 2 (Hertz) with tolerance = 1e-6 and
 # the case's dt as the cap dt_max. No run of it fails a check
 # (docs/stability.md, "Adaptive steps"), so KNOWN lists none: a failure
@@ -299,8 +289,9 @@ def invariants(case, r, law=None):
     # gravity an impact may gain gravity's work m g dx2, so only eps >= 0.
     bad = [i["eps"] for i in impacts if i["eps"] < 0 or (g == 0 and i["eps"] > 1 + rnd)]
     out[EPS] = "" if not bad else f"eps = {bad[0]:.17g}"
-    # Momentum: m v + c x2 - m g t is kept exactly by any Runge-Kutta
-    # method (a linear invariant) and by exact free flight: to rounding.
+    # Momentum: m v + c x2 - m g t is kept exactly by the fixed step (m dv
+    # = -h F = -c dx2), any Runge-Kutta method (a linear invariant) and
+    # exact free flight: to rounding.
     terms = [m * v0, m * r["v"], m * g * r["t"], c * r["x2"]]
     residual = m * (v0 - r["v"]) + m * g * r["t"] - c * r["x2"]
     scale = sum(abs(t) for t in terms)
@@ -336,13 +327,14 @@ def invariants(case, r, law=None):
     out[ENERGY] = "; ".join(why)
     # F <= c v_max: the force grows only while x1' = v - F/c > 0, so it never
     # exceeds c times the largest velocity (v_onset + g t_contact in an
-    # impact; v + g t_end over the run).
-    g_plus = max(g, 0.0)
+    # impact; v + g t_end over the run); a fixed step's, FIXED_FORCE times
+    # that. fig['force'] is F_peak over c v_max, less 1.
+    g_plus, factor = max(g, 0.0), 1.0 if law == ADAPTIVE else FIXED_FORCE
     bounds = [(r["F_peak"], c * (math.sqrt(v0 ** 2 + 2 * g_plus * gap0) + g_plus * r["t"]))]
     bounds += [(i["F_peak"], c * (i["v_onset"] + g_plus * i["t_contact"])) for i in impacts]
     over = max(F / b - 1 if b > 0 else (math.inf if F > 0 else 0.0) for F, b in bounds)
     fig["force"] = over
-    out[FORCE] = "" if over <= rnd else f"F_peak {over:.3g} above c v_max"
+    out[FORCE] = "" if over <= factor * (1 + rnd) - 1 else f"F_peak {over:.3g} above c v_max, more than {factor:g} c v_max"
     return out, fig
 
 

@@ -1,38 +1,15 @@
 """The dashpot's sections of docs/stability.md: how its runs are checked,
-the convergence study, the summary, the adaptive runs, the known findings of
-the time scheme and every run."""
+the convergence study, the summary, the adaptive runs, the failures and
+every run."""
 
 from .core import RESOLVED, check_table
-from .dashpot import (ADAPTIVE, ADAPTIVE_ENERGY, ADAPTIVE_K, ADAPTIVE_TOLERANCE, C2, CHECKS, D1, ENERGY, FORCE, LAWS,
+from .dashpot import (ADAPTIVE, ADAPTIVE_ENERGY, ADAPTIVE_K, ADAPTIVE_TOLERANCE, C2, CHECKS, D1, FIXED_FORCE, LAWS,
                       QUANTITIES, REF_RTOLS)
-
-# Why the runs listed in dashpot.KNOWN fail: properties of the time scheme.
-FINDINGS = {
-    ENERGY: "SDIRK2 creates energy in nearly elastic impacts with the Hertz law. With no dashpot at all "
-            "(c = 1e15, h20) eps - 1 = +1.4e-4 at dt = t_c/12, +1.2e-5 at t_c/49, +3.5e-7 at t_c/197, +1.2e-8 at "
-            "t_c/787, +9.4e-12 at t_c/12300: 0.08 to 0.21 (dt/t_c)^2.5, always positive. The peak force comes "
-            "out low (numerical damping while loading) and the rebound too fast: the gain is made while "
-            "unloading and at separation. Alexander's SDIRK2 is A-stable but not algebraically stable "
-            "(b1 (2 a11 - b1) = (1 - gamma)(3 gamma - 1) < 0), so it has no energy inequality for a non-linear "
-            "spring, and the force k x1^(3/2) is not smooth where x1 = 0. With enough damping (c <= 1e5 here) "
-            "the dashpot's loss hides it; the G1 law's stiffness, falling during the contact, dissipates more "
-            "(first order) and never shows it. Where eps exceeds 1 it is the same gain.",
-    FORCE: "SDIRK2 overshoots the force across an unresolved stiff dashpot: its stability function "
-           "R(z) = (1 + (1 - 2 gamma) z) / (1 - gamma z)^2 is negative for z < -2.41 (at z = -10, R = -0.2), so "
-           "the elastic indentation overshoots its quasi-static value within the first steps after onset and "
-           "F_peak exceeds c v0, which the model's force never does. The overshoot is about 1.5 |R(-lambda dt)|, "
-           "lambda = 1.5/t_q the dashpot's relaxation rate: 24 % at c = 0.01, steel, v0 = 30 m/s, dt = 1e-8 "
-           "(F_peak 0.373 N against the reference's 0.300 N = c v0), 11 % at dt = 1e-7, 1e-6 relative at "
-           "lambda dt = 5e6. L-stable, it stays bounded and decays within a step or two; the impulse, x2, "
-           "v and eps are unaffected (they pass the reference). Resolving the force's rise, dt <= t_F/20, "
-           "removes it.",
-}
-
 
 def adaptive_section(rows):
     """The report's section on the adaptive variant: its runs capped beyond
-    what fixed steps resolve, each figure's error over its bound, the energy
-    it creates within its bound, and the fixed scheme's findings it avoids."""
+    what fixed steps resolve, each figure's error over its bound, and the
+    energy it creates within its bound."""
     mine = [(n, r) for n, c, r in rows if r["law"] == ADAPTIVE]
     if not mine:
         return []
@@ -62,16 +39,7 @@ def adaptive_section(rows):
                 f"({ADAPTIVE_ENERGY:g} (steps) x tolerance of the energy), in {len(beyond)} runs that the energy "
                 "check would fail without that term:", ""]
     out += [f"- {n} ({r['steps']} steps): " + "; ".join(r["energy_beyond_rounding"]) for n, r in beyond] or ["- none"]
-    fixed = {(n, r["law"]): r for n, c, r in rows}
-    avoided = [(n, sorted({f.split(":")[0] for law in ("g1", "hertz")
-                           for f in fixed.get((n, law), {}).get("failures", [])}))
-               for n, r in mine if not r["failures"]]
-    avoided = [(n, f) for n, f in avoided if f]
-    out += ["", f"The fixed scheme's known findings are properties of SDIRK2; the adaptive runs of the same "
-                f"{len(avoided)} cases pass every check (its steps resolve the force's rise: no overshoot "
-                "above c v_max; no energy created beyond its error bound, eps <= 1): "
-                + "; ".join(f"{n} ({', '.join(f)})" for n, f in avoided) + ".", ""]
-    return out
+    return out + [""]
 
 
 def section(study, rows):
@@ -79,7 +47,7 @@ def section(study, rows):
     checks and their tolerances, the convergence study, the summary, the
     adaptive runs, the failures and every run."""
     out = ["Each case runs the model (the C library in-process, `fraccontact.impact`) three ways: with fixed "
-           "implicit SDIRK2 steps of the case's dt (`tolerance` = 0) with the G1 law (N = steps since onset, or the "
+           "implicit discrete-gradient steps of the case's dt (`tolerance` = 0) with the G1 law (N = steps since onset, or the "
            "case's fixed N) and with the Hertz law, and **adaptive**: the Hertz law with error-controlled steps "
            f"(`tolerance` = {ADAPTIVE_TOLERANCE:g}, Kvaerno's L-stable ESDIRK 5(4)) capped by the case's dt "
            "(`dt_max`; the cases with dt = 1e-2 cap them far beyond the contact time). k is derived from the "
@@ -94,20 +62,25 @@ def section(study, rows):
            "- **no tension**: F_peak >= 0 and x1 >= 0;",
            "- **0 <= eps <= 1** for every impact (eps <= 1 only without gravity: under gravity an impact may "
            "gain gravity's work m g dx2);",
-           "- **momentum**: m (v0 - v) + m g t = c x2, a linear invariant that every Runge-Kutta method and "
-           "the exact free flight keep;",
+           "- **momentum**: m (v0 - v) + m g t = c x2, a linear invariant that the fixed step (m dv = -h F = "
+           "-c dx2), every Runge-Kutta method and the exact free flight keep;",
            "- **no energy created**: 1/2 m v^2 + 2/5 k x1^(5/2) + E_diss <= 1/2 m v0^2 + m g (x + gap0) at the "
            "end of the run, and 1/2 m (eps v_on)^2 + E_diss,i <= 1/2 m v_on^2 + m g dx2,i for every impact "
            "(the G1 law's stiffness is never below k and falls during a contact, so its elastic energy is at "
            f"least 2/5 k x1^(5/2)); for the adaptive runs also {ADAPTIVE_ENERGY:g} (steps) x tolerance of that "
-           "energy: the fixed scheme's dissipation per step is J^2/(c h) with J the step's impulse (the mean "
-           "force's work at the mean dashpot rate), the adaptive one a 5th-order quadrature of F^2/c over the stages "
+           "energy: the fixed scheme's dissipation per step is h F^2/c with F its mean force (docs/model.md §11: "
+           "exact, the step keeps the energy to rounding), the adaptive one a 5th-order quadrature of F^2/c over the stages "
            "(two of Kvaerno's weights negative), whose error, as every figure's, has either sign: per step at "
            "most tol (m S^2 + 2 F_peak L) <= 7 tol of the energy, S the speed and L the indentation the error "
            "control scales by (m S^2 is twice the kinetic energy, F_peak L = K L^(5/2) 5/2 times the elastic "
            "energy at the peak);",
            "- **F <= c v_max**: in the model the force grows only while x1' = v - F/c > 0, so it never exceeds c "
-           "times the largest velocity (v_onset + g t_contact in an impact).", "",
+           "times the largest velocity (v_onset + g t_contact in an impact); the adaptive runs are held to "
+           f"that, the fixed steps to {FIXED_FORCE:g} c v_max = (n + 1) c v_max, their bound (docs/model.md §11: "
+           "the mean force of a step exceeds c v only where x1 falls over it, and the force at a step's end is "
+           "at most n + 1 times the mean where x1 rises; across a dashpot too stiff for the step the elastic "
+           "indentation rings about its quasi-static value, and with it the force at the steps' ends, while "
+           "the mean force, which moves the striker, is the dashpot's).", "",
            f"And the **reference** (GSL, rtol {REF_RTOLS[0]:g}; the G1 law with N = steps tends to the Hertz "
            "law, with N fixed the reference uses its stiffness), for each figure whose time scale the step "
            f"resolves, dt <= T/{RESOLVED}: T = t_F = min(t_c, t_q) for F_peak, where t_q = (c v/K)^(2/3)/v is "
@@ -118,7 +91,7 @@ def section(study, rows):
            "C2 (dt/T)^2 [+ D1 dt/T for the G1 law with N = steps] + the reference's own error (its distance to "
            f"the rtol {REF_RTOLS[1]:g} solve) + rounding, with", "",
            "| | " + " | ".join(QUANTITIES) + " |", "|---|" + "---|" * len(QUANTITIES),
-           "| C2 (SDIRK2, second order) | " + " | ".join(f"{C2[q]:g}" for q in QUANTITIES) + " |",
+           "| C2 (fixed steps, second order) | " + " | ".join(f"{C2[q]:g}" for q in QUANTITIES) + " |",
            "| D1 (G1 law, 3/(8N)) | " + " | ".join(f"{D1[q]:g}" for q in QUANTITIES) + " |",
            "| K (adaptive: x steps x tolerance; derived, not measured: below) | " + " | ".join(f"{ADAPTIVE_K[q]:g}" for q in QUANTITIES) + " |",
            "",
@@ -156,7 +129,7 @@ def section(study, rows):
     n_bad = sum(1 for *_, r in rows if r["unexpected"])
     out += ["", "## Summary", "",
             f"**{passed} of {n_runs} runs pass every check; {n_known} fail one as a known finding of the time "
-            f"scheme (below); {n_bad} fail otherwise.**", ""]
+            f"scheme; {n_bad} fail otherwise.**", ""]
     for law in LAWS:
         mine = [r for *_, r in rows if r["law"] == law]
         out.append(f"- {law}: {sum(1 for r in mine if not r['failures'])} of {len(mine)} pass, "
@@ -172,10 +145,8 @@ def section(study, rows):
     if failed:
         out += ["## Failures", "",
                 "Every failure below fails a check that holds in the model at any step; none is widened to "
-                "pass. Those marked *known finding* are two properties of the time scheme (model/sdirk2.c), "
-                "listed in `KNOWN` in reports/stability/dashpot.py so that a fix, or a new failure, "
-                "stops the script:", ""]
-        out += [f"- **{c}**: {FINDINGS[c]}" for c in FINDINGS] + [""]
+                "pass. Those marked *known finding* are listed in `KNOWN` in reports/stability/dashpot.py "
+                "(none is, today) so that a fix, or a new failure, stops the script:", ""]
         for n, r in failed:
             tag = "known finding" if not r["unexpected"] else "UNEXPECTED"
             out.append(f"- {n} (law {r['law']}, dt/t_c = {r['h']:.2g}, dt/t_F = {r['h_F']:.2g}; {tag}): "

@@ -103,7 +103,7 @@ def section(study, rows, elapsed):
            "below): not compared.", "",
            "| | " + " | ".join(QUANTITIES) + " |", "|---|" + "---|" * len(QUANTITIES),
            "| K1 (memory 1: G1 history, BDF2) | " + " | ".join(f"{K1[q]:g}" for q in QUANTITIES) + " |",
-           "| K2 (memory 2: exponentials, SDIRK2) | " + " | ".join(f"{K2[q]:g}" for q in QUANTITIES) + " |",
+           "| K2 (memory 2: exponentials, fixed steps) | " + " | ".join(f"{K2[q]:g}" for q in QUANTITIES) + " |",
            "", "twice the largest the study below measures.", "",
            "## Convergence study (springpot)", "",
            "Each regime with both memories at dt = t_c/20, t_c/40, ..., t_c/2560 (memory 1 up to 3e4 steps) "
