@@ -495,10 +495,10 @@ def test_one_drop_test_is_not_identifiable_and_every_member_of_its_family_reprod
                             v=V0, dt_max=fitted.dt_max / 8, memory_tolerance=1e-9)
         assert abs(fine.F_peak / 1004 - 1) < 2e-6 and abs(fine.eps - 0.59) < 2e-6, (mb["alpha"], fine)
     k, c = fit.fit_peak_and_restitution(1004.0, 0.59, M, V0)
-    # rel 1e-6: the member is the springpot at alpha = 1 on the fit's step, the other the dashpot on its own
-    # steps; both reproduce F_max and eps to rounding, so k and c differ by the two discretisations' errors
-    # (measured 2.5e-7 in k, 8e-7 in c)
-    assert members[0]["k"] == pytest.approx(k, rel=1e-6, abs=0) and members[0]["c_alpha"] == pytest.approx(c, rel=1e-6, abs=0)
+    # The member is the springpot at alpha = 1 on the fit's step, the other the dashpot on its own steps; both
+    # reproduce F_max and eps to rounding, so k and c differ by the two discretisations' errors (measured with
+    # the fixed step of docs/model.md §11: 2.0e-7 in k, 1.9e-6 in c; about twice each allowed)
+    assert members[0]["k"] == pytest.approx(k, rel=5e-7, abs=0) and members[0]["c_alpha"] == pytest.approx(c, rel=4e-6, abs=0)
 
 
 def test_below_the_familys_lowest_order_eps_is_out_of_reach(h20_family):

@@ -120,18 +120,16 @@ def test_the_jacobi_target_in_our_driver_and_libcosim(library, importer):
 def test_no_energy_is_created_at_any_step(H):
     """The striker's kinetic energy after the impact plus E_diss against the
     impact energy: never above it (beyond rounding of the energies, 1e-14),
-    and below it by the scheme's own balance alone: the monolithic run's
-    -2.8e-9 at steps of dt_max (a step's dissipation counted from its mean
-    force, which overshoots by O(h^2)), scaled by (h/dt_max)^2 off the grid
-    of dt_max, where H is split into steps h = H/ceil(H/dt_max) < dt_max
-    (measured within 0.1 % of that; 1 % allowed)."""
-    dt_max = 1e-7
-    reference = monolithic(CONTACT)["energy_error"]
-    h = H / math.ceil(H / dt_max * (1 - 1e-12))
+    and below it by rounding alone, coupled as monolithic: the fixed step's
+    balance E + E_diss is exact but for rounding (docs/model.md §11), which
+    walks like sqrt(n) eps over the n = 13 160 internal steps of the impact
+    (1.3e-14; 4x that allowed)."""
+    bound = 4 * math.sqrt(13160) * EPS
+    assert abs(monolithic(CONTACT)["energy_error"]) <= bound
     for run in (cosimulate(CONTACT, STRIKER, H, "predictive", "jacobi"),
                 cosimulate_libcosim(CONTACT, STRIKER, H, "predictive")):
         assert run["energy_error"] <= 1e-14
-        assert run["energy_error"] == pytest.approx(reference * (h / dt_max) ** 2, rel=1e-2, abs=0)
+        assert abs(run["energy_error"]) <= bound
 
 
 def test_the_striker_receives_the_impulse_the_contact_exerts(slave):
