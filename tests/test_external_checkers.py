@@ -147,28 +147,35 @@ def test_the_checker_finds_nothing_in_fmi_3_0_where_it_reads_it(tmp_path):
 # Exchange): at 1e-8 the peak force is 2.7e-6 off (docs/model_exchange.md's
 # table), at 1e-10 every figure is within 1e-6.
 HOST_RTOL = 1e-10
-WITHIN = 1e-6  # the accuracy asked of F_peak, t_contact, x2 (relative) and eps (absolute)
+WITHIN = 1e-6  # the accuracy asked of F_peak, t_contact, x2, E_diss (relative) and eps (absolute)
 # Co-simulation's rows are its communication points: the contact time is
 # bracketed by the last row in contact and the first out.
 COSIM_STEP = 1e-6
+# The impacts: the h20 drop test, and a striker meeting a moving second body
+# of finite mass (the reduced mass at the approach speed v - v2).
+IMPACTS = {"h20": {}, "two_bodies": {"v": 3.0, "v2": 1.0, "m2": 2.0}}
+# The driven scene: the indentation at the input rate v, no striker inertia.
+DRIVEN, DRIVEN_END = {"scene": 2, "v": 0.1, "m": 0.0}, 1e-3
 
 
-def reference():
-    """The h20 drop test by GSL's high-accuracy integrator at rtol 1e-10:
-    four digits past the 1e-6 asked here."""
-    done = subprocess.run([SOLVE, "--law", "hertz", "--reference", "--rtol", "1e-10", "--json"],
-                          capture_output=True, text=True, timeout=120)
+def reference(values, t_end=1.0):
+    """GSL's high-accuracy solve of law 2 at rtol 1e-10, four digits past
+    the 1e-6 asked here; values by the FMU's names, as its options."""
+    options = [a for name, value in values.items() for a in ("--" + name.replace("_", "-"), str(value))]
+    done = subprocess.run([SOLVE, "--law", "hertz", "--reference", "--rtol", "1e-10", "--json", "--t-end", str(t_end),
+                           *options], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
 
-def simulate(fmu, interface, interval, tmp_path):
-    """fmusim's rows of the drop test at law 2 (every output interval, and
-    before and after each event in Model Exchange), as floats."""
+def simulate(fmu, interface, interval, tmp_path, stop_time, values):
+    """fmusim's rows at law 2 and the values given (every output interval,
+    and before and after each event in Model Exchange), as floats."""
     out = tmp_path / "out.csv"
+    starts = [a for name, value in dict(law=2, **values).items() for a in ("--start-value", name, str(value))]
+    outputs = [a for name in ("contact", "F_peak", "x2", "eps", "E_diss") for a in ("--output-variable", name)]
     done = subprocess.run([FMUSIM, "--interface-type", interface, "--solver", "cvode", "--tolerance", str(HOST_RTOL),
-                           "--start-value", "law", "2", "--stop-time", "2e-3", "--output-interval", str(interval),
-                           *(a for name in ("contact", "F_peak", "x2", "eps") for a in ("--output-variable", name)),
+                           *starts, "--stop-time", str(stop_time), "--output-interval", str(interval), *outputs,
                            "--output-file", str(out), str(fmu)], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stdout + done.stderr
     with open(out, newline="") as f:
@@ -176,36 +183,49 @@ def simulate(fmu, interface, interval, tmp_path):
 
 
 def separation(rows):
-    """The first row out of contact after one in contact, and the onset row."""
+    """The first row in contact, the last one in contact before the first
+    row out after it, and that row."""
     onset = next(i for i, row in enumerate(rows) if row["contact"])
     end = next(i for i in range(onset, len(rows)) if not rows[i]["contact"])
     return rows[onset], rows[end - 1], rows[end]
 
 
-def figures_within(row, ref):
-    """F_peak and x2 within WITHIN relative, eps within WITHIN absolute."""
-    errors = {"F_peak": abs(row["F_peak"] / ref["F_peak"] - 1.0), "x2": abs(row["x2"] / ref["x2_end"] - 1.0),
-              "eps": abs(row["eps"] - ref["eps"])}
+def figures_within(row, ref, keys):
+    """keys within WITHIN relative, eps within WITHIN absolute."""
+    errors = {key: abs(row[key] / ref[key] - 1.0) for key in keys}
+    errors["eps"] = abs(row["eps"] - ref["eps"])
     assert max(errors.values()) < WITHIN, errors
 
 
 @with_fmusim
-def test_fmusim_model_exchange_matches_the_reference(either_fmu, tmp_path):
+@pytest.mark.parametrize("impact", IMPACTS)
+def test_fmusim_model_exchange_matches_the_reference(either_fmu, tmp_path, impact):
     """The separation is an event, its row at the event's time: the contact
     time from the onset's row."""
-    ref = reference()
-    onset, _, end = separation(simulate(either_fmu, "me", 1e-4, tmp_path))
-    figures_within(end, ref)
+    ref = reference(IMPACTS[impact])
+    onset, _, end = separation(simulate(either_fmu, "me", 1e-4, tmp_path, 2e-3, IMPACTS[impact]))
+    figures_within(dict(end, x2_end=end["x2"]), ref, ("F_peak", "x2_end", "E_diss"))
     assert abs((end["time"] - onset["time"]) / ref["t_contact"] - 1.0) < WITHIN
 
 
 @with_fmusim
-def test_fmusim_co_simulation_matches_the_reference(either_fmu, tmp_path):
-    ref = reference()
-    onset, last, end = separation(simulate(either_fmu, "cs", COSIM_STEP, tmp_path))
-    figures_within(end, ref)
+@pytest.mark.parametrize("impact", IMPACTS)
+def test_fmusim_co_simulation_matches_the_reference(either_fmu, tmp_path, impact):
+    ref = reference(IMPACTS[impact])
+    onset, last, end = separation(simulate(either_fmu, "cs", COSIM_STEP, tmp_path, 2e-3, IMPACTS[impact]))
+    figures_within(dict(end, x2_end=end["x2"]), ref, ("F_peak", "x2_end", "E_diss"))
     # the contact begins within the step that ends at the first row in
     # contact (at t = 0, gap0 = 0) and ends within the one that ends at the
     # first row out
     assert onset["time"] - COSIM_STEP <= ref["t_onset"] < onset["time"]
     assert last["time"] < ref["t_onset"] + ref["t_contact"] <= end["time"]
+
+
+@with_fmusim
+@pytest.mark.parametrize("interface", ("me", "cs"))
+def test_fmusim_drives_the_indentation_as_the_reference(either_fmu, tmp_path, interface):
+    """Force, dent and dissipated work at the stop time (eps is 0: no impact ends)."""
+    ref = reference(DRIVEN, DRIVEN_END)["end"]
+    end = simulate(either_fmu, interface, 1e-5, tmp_path, DRIVEN_END, DRIVEN)[-1]
+    assert end["time"] == DRIVEN_END
+    figures_within(end, ref, ("F_peak", "x2", "E_diss"))
