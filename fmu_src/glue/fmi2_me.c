@@ -29,20 +29,6 @@ static fmi2Status refused(fmu_instance *in, const char *name)
     return fmi2Error;
 }
 
-/* Whether an array of n values matches what the FMU has (after logging an error). */
-static int wrong_count(fmu_instance *in, const void *array, size_t n, size_t expected, const char *what,
-                       const char *name)
-{
-    if (fi_null_arrays(in, n, array, array, name))
-        return 1;
-    if (n != expected) {
-        fi_fail(in, "%s: %s = %lu, but this FMU has %lu (modelDescription.xml)", name, what, (unsigned long)n,
-                (unsigned long)expected);
-        return 1;
-    }
-    return 0;
-}
-
 fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time)
 {
     fmu_instance *in = c;
@@ -57,7 +43,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t n
 {
     fmu_instance *in = c;
     REQUIRE(CONTINUOUS_TIME_MODE, "fmi2SetContinuousStates");
-    if (wrong_count(in, x, nx, fm_me_states, "nx", "fmi2SetContinuousStates"))
+    if (fi_wrong_count(in, x, nx, fm_me_states, "nx", "fmi2SetContinuousStates"))
         return fmi2Error;
     return fm_me_set_states(in->fm, x) == FM_OK ? fmi2OK : fmi2Error;
 }
@@ -66,7 +52,7 @@ fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx)
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi2GetContinuousStates");
-    if (wrong_count(in, x, nx, fm_me_states, "nx", "fmi2GetContinuousStates"))
+    if (fi_wrong_count(in, x, nx, fm_me_states, "nx", "fmi2GetContinuousStates"))
         return fmi2Error;
     fm_me_get_states(in->fm, x);
     return fmi2OK;
@@ -76,7 +62,7 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi2GetDerivatives");
-    if (wrong_count(in, derivatives, nx, fm_me_states, "nx", "fmi2GetDerivatives"))
+    if (fi_wrong_count(in, derivatives, nx, fm_me_states, "nx", "fmi2GetDerivatives"))
         return fmi2Error;
     return fm_me_derivatives(in->fm, derivatives) == FM_OK ? fmi2OK : fmi2Error;
 }
@@ -85,7 +71,7 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal
 {
     fmu_instance *in = c;
     REQUIRE(INSTANTIATED | AFTER_INIT_ENTERED, "fmi2GetNominalsOfContinuousStates");
-    if (wrong_count(in, x_nominal, nx, fm_me_states, "nx", "fmi2GetNominalsOfContinuousStates"))
+    if (fi_wrong_count(in, x_nominal, nx, fm_me_states, "nx", "fmi2GetNominalsOfContinuousStates"))
         return fmi2Error;
     fm_me_nominals(in->fm, x_nominal);
     return fmi2OK;
@@ -95,7 +81,7 @@ fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], s
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi2GetEventIndicators");
-    if (wrong_count(in, eventIndicators, ni, fm_me_indicators, "ni", "fmi2GetEventIndicators"))
+    if (fi_wrong_count(in, eventIndicators, ni, fm_me_indicators, "ni", "fmi2GetEventIndicators"))
         return fmi2Error;
     fm_me_event_indicators(in->fm, eventIndicators);
     return fmi2OK;

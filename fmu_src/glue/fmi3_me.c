@@ -28,20 +28,6 @@ static fmi3Status refused(fmu_instance *in, const char *name)
     return fmi3Error;
 }
 
-/* Whether an array of n values matches what the FMU has (after logging an error). */
-static int wrong_count(fmu_instance *in, const void *array, size_t n, size_t expected, const char *what,
-                       const char *name)
-{
-    if (fi_null_arrays(in, n, array, array, name))
-        return 1;
-    if (n != expected) {
-        fi_fail(in, "%s: %s = %lu, but this FMU has %lu (modelDescription.xml)", name, what, (unsigned long)n,
-                (unsigned long)expected);
-        return 1;
-    }
-    return 0;
-}
-
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c)
 {
     fmu_instance *in = c;
@@ -78,7 +64,7 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousS
 {
     fmu_instance *in = c;
     REQUIRE(CONTINUOUS_TIME_MODE, "fmi3SetContinuousStates");
-    if (wrong_count(in, continuousStates, nContinuousStates, fm_me_states, "nContinuousStates",
+    if (fi_wrong_count(in, continuousStates, nContinuousStates, fm_me_states, "nContinuousStates",
                     "fmi3SetContinuousStates"))
         return fmi3Error;
     return fm_me_set_states(in->fm, continuousStates) == FM_OK ? fmi3OK : fmi3Error;
@@ -88,7 +74,7 @@ fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivat
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi3GetContinuousStateDerivatives");
-    if (wrong_count(in, derivatives, nContinuousStates, fm_me_states, "nContinuousStates",
+    if (fi_wrong_count(in, derivatives, nContinuousStates, fm_me_states, "nContinuousStates",
                     "fmi3GetContinuousStateDerivatives"))
         return fmi3Error;
     return fm_me_derivatives(in->fm, derivatives) == FM_OK ? fmi3OK : fmi3Error;
@@ -98,7 +84,7 @@ fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[],
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi3GetEventIndicators");
-    if (wrong_count(in, eventIndicators, nEventIndicators, fm_me_indicators, "nEventIndicators",
+    if (fi_wrong_count(in, eventIndicators, nEventIndicators, fm_me_indicators, "nEventIndicators",
                     "fmi3GetEventIndicators"))
         return fmi3Error;
     fm_me_event_indicators(in->fm, eventIndicators);
@@ -109,7 +95,7 @@ fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[
 {
     fmu_instance *in = c;
     REQUIRE(AFTER_INIT_ENTERED, "fmi3GetContinuousStates");
-    if (wrong_count(in, continuousStates, nContinuousStates, fm_me_states, "nContinuousStates",
+    if (fi_wrong_count(in, continuousStates, nContinuousStates, fm_me_states, "nContinuousStates",
                     "fmi3GetContinuousStates"))
         return fmi3Error;
     fm_me_get_states(in->fm, continuousStates);
@@ -120,7 +106,7 @@ fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominal
 {
     fmu_instance *in = c;
     REQUIRE(INSTANTIATED | AFTER_INIT_ENTERED, "fmi3GetNominalsOfContinuousStates");
-    if (wrong_count(in, nominals, nContinuousStates, fm_me_states, "nContinuousStates",
+    if (fi_wrong_count(in, nominals, nContinuousStates, fm_me_states, "nContinuousStates",
                     "fmi3GetNominalsOfContinuousStates"))
         return fmi3Error;
     fm_me_nominals(in->fm, nominals);

@@ -325,3 +325,17 @@ fi_status fi_deserialize(const fmu_instance *in, const unsigned char *bytes, siz
     *state = s;
     return FI_OK;
 }
+
+/* Whether an array of n values matches what the FMU has (after logging an error). */
+int fi_wrong_count(fmu_instance *in, const void *array, size_t n, size_t expected, const char *what,
+                   const char *name)
+{
+    if (fi_null_arrays(in, n, array, array, name))
+        return 1;
+    if (n != expected) {
+        fi_fail(in, "%s: %s = %lu, but this FMU has %lu (modelDescription.xml)", name, what, (unsigned long)n,
+                (unsigned long)expected);
+        return 1;
+    }
+    return 0;
+}

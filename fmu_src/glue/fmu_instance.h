@@ -63,6 +63,12 @@ int fi_allowed(fmu_instance *in, int states, const char *name);
 /* Whether an array of n > 0 values is missing (after logging an error). */
 int fi_null_arrays(const fmu_instance *in, size_t n, const void *a, const void *b, const char *name);
 
+/* Whether an array of n values (a Model Exchange call's states, derivatives
+ * or indicators) is missing or not the `expected` count the FMU has, after
+ * logging an error naming `what`. */
+int fi_wrong_count(fmu_instance *in, const void *array, size_t n, size_t expected, const char *what,
+                   const char *name);
+
 fi_status fi_set_debug_logging(fmu_instance *in, int logging_on, size_t n, const char *const categories[],
                                const char *name);
 
