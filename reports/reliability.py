@@ -14,6 +14,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 
 from tqdm import tqdm
 
@@ -23,11 +24,17 @@ from fraccontact.output import make_folder
 from . import BAR, source_tree
 
 ROOT = source_tree()
-FMU_SOURCES = ["fmu_src/glue/fmi2_cosim.c", "fmu_src/glue/fmi2_me.c", "fmu_src/binding/fmu_model.c",
-               "fmu_src/glue/fmu_instance.c", "fmu_src/glue/fmu_vars.c", "fmu_src/glue/serial.c", "model/g1.c"] + [
-    f"model/{name}.c" for name in ("soe", "parameters", "method", "resolution", "model", "stage", "sdirk2",
-                                           "esdirk54", "radau_iia", "control", "events", "evolve", "g1_history", "central",
-                                           "passivity", "rates")]
+
+
+def fmu_sources():
+    """The FMU's C sources as its modelDescription.xml lists them (co-simulation's SourceFiles, the fullest),
+    each found in the folder that holds it."""
+    names = [f.get("name") for f in ET.parse(ROOT / "modelDescription.xml").getroot().iter("File")]
+    folders = ("model", "fmu_src/glue", "fmu_src/binding")
+    return list(dict.fromkeys(next(f"{d}/{n}" for d in folders if (ROOT / d / n).exists()) for n in names))
+
+
+FMU_SOURCES = fmu_sources()
 
 
 def sh(*args, **kw):
@@ -68,8 +75,10 @@ def fuzz(seconds):
     sh("cmake", "--build", "build-fuzz", "--target", "fuzz_fmi2", "-j", "2")
     corpus = ROOT / "build-fuzz" / "fuzz_corpus"
     corpus.mkdir(exist_ok=True)
+    # -timeout: an input slow enough to hang the report is a finding (fuzz-crash-*), not a wait
     done = subprocess.run([ROOT / "build-fuzz" / "fuzz_fmi2", f"-max_total_time={seconds}", "-print_final_stats=1",
-                           "-artifact_prefix=build-fuzz/fuzz-crash-", corpus, ROOT / "tests" / "fuzz_corpus"],
+                           "-timeout=10", "-artifact_prefix=build-fuzz/fuzz-crash-", corpus,
+                           ROOT / "tests" / "fuzz_corpus"],
                           capture_output=True, text=True, cwd=ROOT)
     stats = dict(re.findall(r"stat::(\w+):\s+(\d+)", done.stderr))
     edges = re.findall(r"cov: (\d+)", done.stderr)
@@ -136,7 +145,7 @@ def memory_sentence(m):
     return ("- **Memory per configuration** (`fraccontact-soak memory`: the heap bytes an initialized FMU instance "
             "holds, malloc's own overhead included, and its serialized FMU state's size): " + sizes + ". A dashpot "
             "instance holds no springpot memory: at most 2 KiB. The compressed memory's M modes take, in the model "
-            "and again in its prediction of the next step, one block of 13 arrays of M doubles rounded up to whole "
+            "and again in its prediction of the next step, one block of 12 arrays of M doubles rounded up to whole "
             "8 lanes, allocated at initialization (never in a step); the FMU state 8 B a mode. The full G1 "
             "history's buffer grows as the run steps (16 B a step; 8 B a step in the state).")
 

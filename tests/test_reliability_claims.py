@@ -48,10 +48,10 @@ def test_the_memory_per_instance_is_what_an_instance_holds():
 # value: x2' and the M modes (memory = 2), or v and the G1 sum one step back
 # and x2 at each step, x2(0) alone before the first (memory = 1).
 SPRINGPOT_STATE = 3 * 8 + 4 + 8
-# The compressed memory's block (model/model.c): 13 arrays of doubles, each
+# The compressed memory's block (model/model.c): 12 arrays of doubles, each
 # of M rounded up to whole 8 lanes; one in the model, one in its prediction.
 # malloc adds its header and alignment to each, under 32 B.
-MODE_ARRAYS, LANES, MALLOC_OVERHEAD = 13, 8, 32
+MODE_ARRAYS, LANES, MALLOC_OVERHEAD = 12, 8, 32
 
 
 @pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
@@ -61,7 +61,7 @@ def test_the_memory_per_configuration_is_what_an_instance_allocates():
     size, per configuration, as fraccontact-soak memory measures them and
     the page writes them; a dashpot instance at most 2 KiB; and what a
     springpot adds, from the layouts: the state 8 B a value of its memory,
-    the instance two blocks of 13 arrays of the modes padded to whole lanes,
+    the instance two blocks of 12 arrays of the modes padded to whole lanes,
     so that it grows with the kernel's mode count."""
     sizes, = claim(r"\*\*Memory per configuration\*\* \(`fraccontact-soak memory`: the heap bytes an initialized "
                    r"FMU instance holds, malloc's own overhead included, and its serialized FMU state's size\): "
