@@ -230,6 +230,8 @@ def test_the_derivatives_are_the_dashpot_models(instance):
     assert not dx[4:].any()
     assert i.get("F") == pytest.approx(F, rel=1e-15, abs=0)
     assert i.get("der(x2)") == dx[2]
+    # the onset/separation indicator is the indentation x1 = x - x2, one subtraction: exact
+    assert i.get("event_x1") == x[0] - x[2]
 
 
 def test_the_springpots_modes_relax_at_their_rates(instance):
