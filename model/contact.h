@@ -462,6 +462,12 @@ void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, dou
  * memory (negative while the dent recovers). */
 double contact_damper_rate(const contact_model *cm);
 
+/* The dent x2 where the last contact ended, right after the advance that
+ * ended it: a uniform grid ends a contact at the step after its separation,
+ * and takes x2 back to the separation (the full G1 history continues it
+ * from the contact's side, g1_history.c; the others along x2's rate). */
+double contact_x2_end(const contact_model *cm);
+
 /* Advances the model by H >= 0 to exactly t + H by the method of
  * contact_method. Out of contact free flight is one exact step (while a
  * springpot recovers, steps growing with the time since separation). In

@@ -99,6 +99,8 @@ void end_contact(contact_state *s, double t, double v);
 
 /* g1_history.c */
 int history_reserve(contact_history *hist, size_t count);
+/* contact_x2_end of the full G1 history. */
+double g1_history_x2_end(const contact_model *cm);
 
 /* The G1 ratio of the law on N intervals for x1^n = Gamma(n+1) D^(-(n-1)) x1
  * (docs/model.md §4): Gamma(N+n)/(Gamma(N) N^n). */

@@ -36,21 +36,82 @@ int history_reserve(contact_history *hist, size_t count)
     return 0;
 }
 
-/* Contact's onset and end after a grid step from *before (x1 crossed 0 at
- * the fraction of the step where its linear interpolation does). */
+/* x2 at the fraction theta of the grid step after point i, continued from
+ * the step's start by the parabola through x2 at points i - 2, i - 1 and i:
+ * x2[i] + slope theta + curve theta^2. Before a separation x2 is smooth;
+ * past it F = 0, and x2 = I^alpha(F/c_alpha) recovers with a second
+ * derivative ~ (t - t_s)^(alpha - 1), so that a secant to the grid point
+ * after the separation would err at the order 1 + alpha. */
+static void x2_continued(const double *x2, size_t i, double *slope, double *curve)
+{
+    const double d1 = x2[i] - x2[i - 1], d2 = x2[i - 1] - x2[i - 2];
+    *slope = 0.5 * (3.0 * d1 - d2);
+    *curve = 0.5 * (d1 - d2);
+}
+
+/* Whether the separation in the grid step just taken is located with x2
+ * continued from the contact's side: the contact spans the three grid
+ * points before the step that x2_continued takes. */
+static int separation_extrapolates(const contact_state *s) { return s->n >= 3; }
+
+/* The fraction of the grid step from *before (point j - 1) to the state
+ * (point j) where the indentation x1 = x - x2 falls to 0 at a separation:
+ * the root in the step of x, linear between the two grid points (its
+ * curvature -F/m + g is the force's, near 0 there), less x2_continued. 1
+ * when that stays in contact to the step's end (the root beyond it by the
+ * scheme's error); x1's secant where x2 cannot be continued or x1 was not
+ * positive before. */
+static double separation_fraction(const contact_model *cm, const contact_state *before)
+{
+    const contact_state *s = &cm->s;
+    const double C = before->x1;
+    double slope, curve, A, B;
+    if (!separation_extrapolates(before) || !(C > 0.0))
+        return before->x1 / (before->x1 - s->x1);
+    /* x1(theta) = C + B theta + A theta^2 */
+    x2_continued(cm->history.x2, (size_t)s->steps - 1, &slope, &curve);
+    A = -curve;
+    B = (s->x1 + s->x2) - (before->x1 + before->x2) - slope;
+    if (!(C + B + A < 0.0))
+        return 1.0;
+    /* the root between theta = 0 (x1 > 0) and 1 (x1 < 0), without
+     * cancellation; B^2 - 4AC > 0 there but for rounding */
+    return 2.0 * C / (sqrt(larger(B * B - 4.0 * A * C, 0.0)) - B);
+}
+
+double g1_history_x2_end(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    const double *x2 = cm->history.x2;
+    const double theta = 1.0 - (s->t - (s->t_onset + s->t_contact)) / cm->h_max;
+    const size_t i = (size_t)s->steps - 1;
+    double slope, curve;
+    if (!separation_extrapolates(s))
+        return x2[i] + theta * (s->x2 - x2[i]);
+    x2_continued(x2, i, &slope, &curve);
+    return x2[i] + theta * (slope + theta * curve);
+}
+
+/* Contact's onset and end after a grid step from *before: x1 crossed 0 at
+ * the fraction of the step where its linear interpolation does (onset) or
+ * separation_fraction's (end), v interpolated linearly there. */
 static int g1_contact_events(contact_model *cm, const contact_state *before, unsigned stop_at)
 {
     contact_state *s = &cm->s;
-    const double frac = before->x1 / (before->x1 - s->x1), h = s->t - before->t;
-    const double t = before->t + frac * h, v = before->v + frac * (s->v - before->v);
-    if (!before->in_contact && s->F > 0.0)
-        begin_contact(s, t, v);
+    const double h = s->t - before->t;
+    double frac;
+    if (!before->in_contact && s->F > 0.0) {
+        frac = before->x1 / (before->x1 - s->x1);
+        begin_contact(s, before->t + frac * h, before->v + frac * (s->v - before->v));
+    }
     if (s->F > 0.0)
         count_contact_step(s, s->F);
     /* as the fixed steps: a contact ends with the indentation falling, not
      * while the striker still moves in and x1 rounds to 0 */
-    if (before->in_contact && s->in_contact && !(s->F > 0.0) && !(s->v - s->x2_rate > 0.0))
-        end_contact(s, t, v);
+    if (before->in_contact && s->in_contact && !(s->F > 0.0) && !(s->v - s->x2_rate > 0.0)) {
+        frac = separation_fraction(cm, before);
+        end_contact(s, before->t + frac * h, before->v + frac * (s->v - before->v));
+    }
     if (s->in_contact == before->in_contact && s->impacts == before->impacts)
         return 0;
     return (stop_at & (s->in_contact ? CONTACT_ONSET : CONTACT_SEPARATION)) != 0;
@@ -62,8 +123,8 @@ static int g1_contact_events(contact_model *cm, const contact_state *before, uns
  * D^alpha x2 at t_j to O(h^2); with BDF2 for the striker (backward Euler on
  * the first step) the step is second order and L-stable, and at alpha = 1
  * it is BDF2 throughout. The damper's relation is linear in F_j, as in a
- * stage. Contact begins and ends at a step (no step is split), its times
- * interpolated linearly. 0, 1 after an event of the mask stop_at, or -1
+ * stage. Contact begins and ends at a step (no step is split), at times
+ * located within it (g1_contact_events). 0, 1 after an event of the mask stop_at, or -1
  * when memory runs out. */
 static int g1_history_step(contact_model *cm, double *impulse, unsigned stop_at)
 {

@@ -205,6 +205,14 @@ double contact_damper_rate(const contact_model *cm)
     return springpot(cm) ? cm->s.x2_rate : cm->s.F * cm->inv_c;
 }
 
+double contact_x2_end(const contact_model *cm)
+{
+    const contact_state *s = &cm->s;
+    if (full_history(cm))
+        return g1_history_x2_end(cm);
+    return s->x2 - contact_damper_rate(cm) * (s->t - (s->t_onset + s->t_contact));
+}
+
 void contact_rates(const contact_model *cm, double *x1_rate, double *v_rate, double *F_rate)
 {
     const contact_state *s = &cm->s;

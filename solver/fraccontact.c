@@ -435,9 +435,8 @@ static void summarize(const contact_model *cm, fc_outcome *o)
     o->k = cm->k;
 }
 
-/* The impact that has just ended, its dissipation counted from its onset;
- * the dent where it ended (the full G1 history ends a contact on its grid,
- * a fraction of a step later: x2 there, less its rate over that fraction). */
+/* The impact that has just ended, its dissipation counted from its onset,
+ * and the dent where it ended. */
 static fc_impact finished_impact(const contact_model *cm, double E_diss_onset)
 {
     const contact_state *s = &cm->s;
@@ -447,7 +446,7 @@ static fc_impact finished_impact(const contact_model *cm, double E_diss_onset)
     done.F_peak = s->F_peak_contact;
     done.eps = s->eps;
     done.t_contact = s->t_contact;
-    done.x2_end = s->x2 - contact_damper_rate(cm) * (s->t - (s->t_onset + s->t_contact));
+    done.x2_end = contact_x2_end(cm);
     done.E_diss = s->E_diss - E_diss_onset;
     return done;
 }
