@@ -74,7 +74,7 @@ G1, MODEL, STATE, INSTANCE = \
 # The model's files (model/): one responsibility each.
 PARAMETERS, LIFE, GRADIENT, RADAU, EVENTS, EVOLVE, PASSIVITY = ("model/" + f for f in (
     "parameters.c", "model.c", "gradient.c", "radau_iia.c", "events.c", "evolve.c", "passivity.c"))
-CONTACT_H = "model/contact.h"
+CONTACT_H, HISTORY = "model/contact.h", "model/g1_history.c"
 SOLVE, STRIKER = "solver/fraccontact.c", "striker/striker_model.c"
 STRUCTURAL = "structural (no tolerance involved)"
 
@@ -181,6 +181,17 @@ MUTANTS = [
            STRUCTURAL + "; test_api::test_a_batch_shares_a_springpots_kernel_only_between_runs_alike: each run of an "
            "interleaved batch exactly as alone",
            (LIFE, "           && k->memory_tolerance == p->memory_tolerance;", "           && 1;")),
+    mutant("history-separation-secant", "springpot memory", "memory 1: the separation along x1's secant across "
+           "its grid step, x2 not continued from the contact's side",
+           "t_contact's orders 0.77, 2.32 at alpha 0.05, n 1; test_springpot::"
+           "test_full_history_locates_the_separation_at_second_order_at_small_alpha, band [1.9, 2.2]",
+           (HISTORY, "return 2.0 * C / (sqrt(larger(B * B - 4.0 * A * C, 0.0)) - B);",
+            "return before->x1 / (before->x1 - s->x1);")),
+    mutant("history-x2_end-secant", "springpot memory", "memory 1: x2_end along x2's secant to the grid point "
+           "after the separation",
+           "x2_end's orders 0.73, 2.46 at alpha 0.05, n 1; test_springpot::"
+           "test_full_history_locates_the_separation_at_second_order_at_small_alpha, band [1.9, 2.2]",
+           (HISTORY, "return x2[i] + theta * (slope + theta * curve);", "return x2[i] + theta * (s->x2 - x2[i]);")),
     mutant("copy-padding", "springpot memory", "contact_copy leaves the modes padded to whole lanes as the "
            "memory it copies into held them",
            STRUCTURAL + "; test_contact test_a_copy_steps_as_its_original: a copy into 0xff bytes steps as its "

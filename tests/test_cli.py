@@ -248,6 +248,28 @@ def test_a_report_makes_its_folder_before_computing(report, monkeypatch, tmp_pat
     assert seen == [True]
 
 
+def test_stability_springpot_alone_needs_the_report_it_rewrites(report, monkeypatch, tmp_path):
+    monkeypatch.setattr(stability.springpot, "convergence", no_run)
+    status, out, err = report("stability", "--springpot", "--out", tmp_path)
+    assert status == 2 and out == "" and list(tmp_path.iterdir()) == []
+    one_line(err, f"--springpot rewrites the springpot part of {tmp_path / 'stability.md'}: it has none")
+
+
+def test_stability_springpot_alone_keeps_the_rest_of_the_report(report, monkeypatch, tmp_path):
+    """--springpot computes the springpot's part alone and replaces it,
+    every line before its heading kept as it was."""
+    page = tmp_path / "stability.md"
+    page.write_text("# head\n\ndashpot\n\n# The springpot (damper = 2)\n\nold\n")
+    monkeypatch.setattr(stability, "over", lambda *args: [])
+    monkeypatch.setattr(stability.dashpot, "convergence", no_run)
+    monkeypatch.setattr(stability.springpot_report, "section",
+                        lambda *args: ["", "# The springpot (damper = 2)", "", "new"])
+    monkeypatch.setattr(stability.springpot_report, "summary", lambda *args: ("springpot: none run", []))
+    status, out, _ = report("stability", "--springpot", "--out", tmp_path)
+    assert status == 0 and out == "springpot: none run\n"
+    assert page.read_text() == "# head\n\ndashpot\n\n# The springpot (damper = 2)\n\nnew\n"
+
+
 def test_a_report_refuses_a_folder_it_cannot_make(report, monkeypatch, tmp_path):
     monkeypatch.setattr(calibration, "write_report", no_run)
     (tmp_path / "file").write_text("")

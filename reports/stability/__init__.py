@@ -26,7 +26,8 @@ each other (see springpot.check). Writes docs/stability.md; exits 1 if a check
 fails that is not a listed known finding (or reported defect), or a listed
 one no longer fails.
 
-Regenerate: scripts/report stability   (pytest runs the FAST subset)
+Regenerate: scripts/report stability   (pytest runs the FAST subset;
+--springpot the springpot's part alone)
 """
 
 import time
@@ -37,16 +38,31 @@ from . import dashpot, dashpot_report, springpot, springpot_report
 from .core import over
 
 
+def springpot_kept(parser, path):
+    """The lines of the report at path before its springpot part (which
+    --springpot rewrites); a usage error where there is none."""
+    text = path.read_text() if path.is_file() else ""
+    if springpot_report.HEADING not in text:
+        parser.error(f"--springpot rewrites the springpot part of {path}: it has none "
+                     f"(no line {springpot_report.HEADING.strip()!r}); run without --springpot first")
+    return text.split(springpot_report.HEADING)[0].removesuffix("\n").split("\n")
+
+
 def main(argv=None, prog=None):
     parser = output.parser(prog, __doc__)
     output.add_solver(parser, "fraccontact-solve, for its GSL reference")
     parser.add_argument("--fast", action="store_true", help="the subset pytest runs")
+    parser.add_argument("--springpot", action="store_true",
+                        help="the springpot's part alone: its sections of the file rewritten, the rest kept")
     args = output.parse(parser, argv)
+    target = args.out / ("stability_fast.md" if args.fast else "stability.md")
+    kept = springpot_kept(parser, target) if args.springpot else None
     # The dashpot: its convergence study, then its matrix, every case with every law.
     start = time.monotonic()
-    study = over(dashpot.CONVERGENCE, args.fast, dashpot.FAST_CONVERGENCE, "convergence: ",
-                 lambda name, case: [dashpot.convergence(args.solver, name, case, law) for law in ("hertz", "g1")])
-    rows = over(dashpot.matrix(), args.fast, dashpot.FAST, "", lambda name, case: [
+    study = [] if kept else over(
+        dashpot.CONVERGENCE, args.fast, dashpot.FAST_CONVERGENCE, "convergence: ",
+        lambda name, case: [dashpot.convergence(args.solver, name, case, law) for law in ("hertz", "g1")])
+    rows = [] if kept else over(dashpot.matrix(), args.fast, dashpot.FAST, "", lambda name, case: [
         (name, case, dashpot.check(args.solver, case, law, name)) for law in dashpot.LAWS])
     seconds = time.monotonic() - start
     # The springpot: its study, then its matrix, both memories per case.
@@ -59,11 +75,12 @@ def main(argv=None, prog=None):
     head = ["# Stability and accuracy on stiff and extreme cases", "",
             f"Regenerate: `scripts/report stability` ({(seconds + sp_seconds) / 60:.1f} min here). `pytest` runs a "
             "fast subset (`tests/test_stability.py`) in CI.", ""]
-    lines = head + dashpot_report.section(study, rows) + springpot_report.section(sp_study, sp_rows, sp_seconds)
-    atomic.write_text(args.out / ("stability_fast.md" if args.fast else "stability.md"), "\n".join(lines) + "\n")
+    lines = (kept or head + dashpot_report.section(study, rows)) + springpot_report.section(sp_study, sp_rows,
+                                                                                            sp_seconds)
+    atomic.write_text(target, "\n".join(lines) + "\n")
     bad = []
-    for line, failures in (dashpot_report.summary(study, rows, seconds),
-                           springpot_report.summary(sp_study, sp_rows, sp_seconds)):
+    summaries = [] if kept else [dashpot_report.summary(study, rows, seconds)]
+    for line, failures in summaries + [springpot_report.summary(sp_study, sp_rows, sp_seconds)]:
         print(line)
         bad += failures
     for name, where, f in bad:
