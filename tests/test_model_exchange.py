@@ -538,6 +538,60 @@ def test_the_fmi3_fmu_refuses_restores_and_counts_as_the_fmi2_one(model_descript
     fmu.freeInstance()
 
 
+def test_an_fmi3_model_exchange_instance_speaks_of_model_exchange(model_description):
+    """The refusals of an FMI 3.0 instance for Model Exchange name the
+    function that made it, its calls and its states, never co-simulation's
+    own (fmi3InstantiateCoSimulation, Step Mode, communication steps); a
+    co-simulation function called on it says what it is and what to call
+    instead. An impact's end is logged without counting communication
+    steps."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi3 import FMU3Model
+    md = read_model_description(str(FMU3))
+    folder = extract(str(FMU3))
+    said = []
+    log = lambda env, status, category, message: said.append(message.decode())
+    for name, guid, rule in (("", md.guid, "instanceName must be a non-empty string"),
+                             ("me3", "{not the token}", "instantiationToken does not match")):
+        made = FMU3Model(guid=guid, unzipDirectory=folder, modelIdentifier=md.modelExchange.modelIdentifier,
+                         instanceName=name)
+        with pytest.raises(Exception):
+            made.instantiate(logMessage=log)
+        assert said[-1].startswith("fmi3InstantiateModelExchange: " + rule), said
+    fmu = FMU3Model(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.modelExchange.modelIdentifier,
+                    instanceName="me3")
+    fmu.instantiate(loggingOn=True, logMessage=log)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu.enterInitializationMode()
+    fmu.setInt32([vr["law"]], [2])
+    fmu.exitInitializationMode()
+    pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    x = np.zeros(STATES)
+    with pytest.raises(Exception):
+        fmu.setContinuousStates(pointer(x), STATES)
+    assert said[-1] == ("fmi3SetContinuousStates: illegal call sequence: called in state Event Mode, allowed only "
+                        "in Continuous-Time Mode"), said[-1]
+    for call, args in (("fmi3EnterStepMode", ()), ("fmi3DoStep", (0.0, 1e-6, False, None, None, None, None))):
+        with pytest.raises(Exception):
+            getattr(fmu, call)(fmu.component, *args)
+        assert said[-1].startswith(call + " is a function of co-simulation: this instance was made by "
+                                   "fmi3InstantiateModelExchange"), said[-1]
+    fmu.updateDiscreteStates()
+    fmu.enterContinuousTimeMode()
+    fmu.getContinuousStates(pointer(x), STATES)
+    for total, velocity in ((2e-4, 0.3), (-1e-6, -0.3)):  # into contact, then out of it
+        x[:2] = total, velocity
+        fmu.setContinuousStates(pointer(x), STATES)
+        fmu.enterEventMode()
+        fmu.updateDiscreteStates()
+        fmu.enterContinuousTimeMode()
+    assert any(m.startswith("impact 1 ended at t = 0 s") for m in said), said
+    fmu.terminate()
+    fmu.freeInstance()
+    for word in ("CoSimulation", "Step Mode", "communication step"):
+        assert not [m for m in said if word in m and "is a function of co-simulation" not in m], word
+
+
 def test_the_nominals_are_the_impacts_scales(instance):
     """The lengths' nominal is the elastic Hertz impact's largest
     indentation (5 m v0^2 / (4 k))^(2/5) (the spring's energy holding the
