@@ -29,6 +29,8 @@ Regenerate: scripts/report benchmarks   (about 20 minutes)
             scripts/report benchmarks --only package     (section 4 alone, in place)
             scripts/report benchmarks --only springpot   (section 5 alone, in place)
             scripts/report benchmarks --only instructions  (the instruction counts alone, in place)
+            scripts/report benchmarks --only exchange  (Model Exchange against co-simulation, and with and
+                                                        without the directional derivatives, in place)
 """
 
 import contextlib
@@ -1573,5 +1575,8 @@ def main(argv=None, prog=None):
     say("the springpot under error control ...")
     controlled = controlled_section(*controlled_rows(bench))
     write(args.out / "benchmarks.md", steps, precision_lines, g1, -0.5, package, springpot, controlled)
+    say("Model Exchange ...")
+    replace_section(args.out / "benchmarks.md", exchange_section(*exchange_rows(program, args.fmu)), EXCHANGE_BEGIN,
+                    EXCHANGE_END)
     print((args.out / "benchmarks.md").read_text())
 
