@@ -11,6 +11,7 @@ import os
 import pathlib
 import subprocess
 import sys
+import tempfile
 import zipfile
 
 import numpy as np
@@ -205,7 +206,9 @@ def exchange_in_omsimulator(fmu, stop_time, values, read):
         getattr(lib, name).argtypes, getattr(lib, name).restype = args, integer
     system_sc, solver_cvode = 2, 3  # oms_system_enu_t, oms_solver_enu_t (OMSimulator/Types.h)
     value, found = ctypes.c_double(), {}
-    with omsimulator.quiet():
+    with omsimulator.quiet(), tempfile.TemporaryDirectory(prefix="fraccontact-omsimulator-") as folder:
+        # its own: OMSimulator keeps the last one set, which an earlier run may have removed
+        omsimulator.call(lib, "oms_setTempDirectory", folder.encode())
         omsimulator.call(lib, "oms_newModel", b"me")
         try:
             omsimulator.call(lib, "oms_addSystem", b"me.root", system_sc)
