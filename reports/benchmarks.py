@@ -1479,9 +1479,8 @@ def exchange_section(h20, springpot):
     out = [EXCHANGE_BEGIN, "## Model Exchange against co-simulation, and the directional derivatives", "",
            "Regenerate this section alone, in place: `scripts/report benchmarks --only exchange` (under a minute). "
            f"The h20 impact (law 2, the dashpot) over {EXCHANGE_STOP * 1e3:g} ms with output points "
-           f"{EXCHANGE_INTERVAL * 1e6:g} us apart, through fmpy {fmpy_version}'s `simulate_fmu` and the FMI 2.0 FMU: by "
-           "Model "
-           "Exchange, fmpy's CVode (BDF, its Newton matrix by difference quotients), and by co-simulation, the "
+           f"{EXCHANGE_INTERVAL * 1e6:g} us apart, through fmpy {fmpy_version}'s `simulate_fmu` and the FMI 2.0 "
+           "FMU: by Model Exchange, fmpy's CVode (BDF, its Newton matrix by difference quotients), and by co-simulation, the "
            "FMU's error-controlled steps (ESDIRK 5(4), each output point a communication step); each at the "
            "coarsest setting from which on every finer one keeps F_peak within 1e-6 of GSL's "
            "(`fraccontact-solve --reference --law hertz`), CPU time of the whole run, fmpy's Python loop included, "
