@@ -32,6 +32,19 @@ PLACES = ("model", "fmu", "library", "solver", "package")
 INITIAL_DEPENDENCIES = {"x": ("gap0",), "v_striker": ("v", "v2")}
 # Model Exchange's derivatives that depend on a variable at the start: der(x) = v - v2, der(v_striker) = g.
 EXCHANGE_DEPENDENCIES = {"der(x)": ("v", "v2"), "der(v_striker)": ("g",)}
+# What each state's rate depends on in continuous-time and event mode (model/rates.c), with the
+# FMI dependenciesKind of each: der(x) = v_striker in the drop test and the input rate v - v2 in the
+# driven scene (factors 1, 0 and +-1, 0 that the fixed scene decides); der(v_striker) = g - F/m and the
+# dashpot's x2' = F/c with the force F of x1 = x - x2; the springpot's x2' = (F/c_alpha - sum_j a_j
+# phi_j)/eta; der(E_diss) = F x2'; der(phi[i]) = x2' - b_i phi_i (a_j, b_i, eta: the kernel of fixed
+# parameters). A STATE row's name stands for all its elements, as known and as state.
+RATE_DEPENDENCIES = {
+    "x": {"v": "fixed", "v_striker": "fixed", "v2": "fixed"},
+    "v_striker": {"x": "dependent", "x2": "dependent"},
+    "x2": {"x": "dependent", "x2": "dependent", "phi": "fixed"},
+    "E_diss": {"x": "dependent", "x2": "dependent", "phi": "dependent"},
+    "phi": {"x": "dependent", "x2": "dependent", "phi": "fixed"},
+}
 ARGUMENT = re.compile(r'\s*((?:"[^"\\]*"\s*)+|[^,"]*?)\s*(,|$)')
 
 
@@ -151,6 +164,19 @@ def exchange_dependencies(variable, by_name, key):
     return " ".join(by_name[d][key] for d in EXCHANGE_DEPENDENCIES.get(variable["name"], ()))
 
 
+def rate_dependencies(variable, fmu, variables, key):
+    """The dependencies and dependenciesKind attributes of the derivative `variable`: its
+    RATE_DEPENDENCIES as FMI 2.0 indices or FMI 3.0 value references (key), in ascending order."""
+    state = re.sub(r"\[\d+\]$", "", variable["derivative"])
+    known = {r["name"]: [r[key]] for r in fmu}
+    for v in variables:
+        if not v["derivative"] and not v.get("indicator"):
+            known.setdefault(re.sub(r"\[\d+\]$", "", v["name"]), []).append(v[key])
+    pairs = sorted((int(ref), kind) for name, kind in RATE_DEPENDENCIES[state].items() for ref in known[name])
+    return (f' dependencies="{" ".join(str(ref) for ref, _ in pairs)}"'
+            f' dependenciesKind="{" ".join(kind for _, kind in pairs)}"')
+
+
 def fmi2_section(rows):
     """From <ModelVariables> to </ModelStructure> of modelDescription.xml."""
     fmu = fmu_rows(rows)
@@ -167,7 +193,8 @@ def fmi2_section(rows):
     if derivatives:
         lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md); at the "
                   "start der(x) = v - v2 (1, 36), der(v_striker) = g (11), the rest 0 -->"]
-        lines += [f'      <Unknown index="{v["index"]}"/>' for v in derivatives] + ["    </Derivatives>"]
+        lines += [f'      <Unknown index="{v["index"]}"{rate_dependencies(v, fmu, exchange, "index")}/>'
+                  for v in derivatives] + ["    </Derivatives>"]
     lines += ["    <InitialUnknowns>", f"      <!-- {initial_comment(by_name, 'index')} -->"]
     lines += [f'      <Unknown index="{r["index"]}" dependencies="{dependencies(r, by_name, "index")}"/>'
               for r in outputs]
@@ -215,7 +242,8 @@ def fmi3_section(rows):
     lines += [f'    <Output valueReference="{r["vr"]}"/>' for r in outputs]
     if derivatives:
         lines += ["    <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
-        lines += [f'    <ContinuousStateDerivative valueReference="{v["vr"]}"/>' for v in derivatives]
+        lines += [f'    <ContinuousStateDerivative valueReference="{v["vr"]}"'
+                  f'{rate_dependencies(v, fmu, exchange, "vr")}/>' for v in derivatives]
     lines += [f"    <!-- {initial_comment(by_name, 'vr')} -->"]
     lines += [f'    <InitialUnknown valueReference="{r["vr"]}" dependencies="{dependencies(r, by_name, "vr")}"/>'
               for r in outputs]

@@ -29,6 +29,8 @@ Regenerate: scripts/report benchmarks   (about 20 minutes)
             scripts/report benchmarks --only package     (section 4 alone, in place)
             scripts/report benchmarks --only springpot   (section 5 alone, in place)
             scripts/report benchmarks --only instructions  (the instruction counts alone, in place)
+            scripts/report benchmarks --only exchange  (Model Exchange against co-simulation, and with and
+                                                        without the directional derivatives, in place)
 """
 
 import contextlib
@@ -1326,16 +1328,206 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
     atomic.write_text(path, "\n".join(out) + "\n")
 
 
+# --- Model Exchange ----------------------------------------------------------
+
+EXCHANGE_BEGIN, EXCHANGE_END = "<!-- model exchange: begin -->", "<!-- model exchange: end -->"
+EXCHANGE_STOP, EXCHANGE_INTERVAL = 2e-3, 1e-5  # the h20 impact's run and its output (communication) points
+EXCHANGE_RTOLS = tuple(10.0 ** -k for k in range(6, 13))  # fmpy CVode's relative tolerance, coarse to fine
+COSIM_TOLERANCES = tuple(10.0 ** -k for k in range(6, 13))  # the co-simulation's error-controlled steps
+SPRINGPOT_RTOL = 1e-8  # the springpot's run in Model Exchange, with and without the directional derivatives
+
+
+def cvode_counting():
+    """fmpy's CVode with its work counted (steps, right-hand sides, Jacobians,
+    the right-hand sides of its difference-quotient Jacobians), and, with
+    jacobian=True, its Newton matrix from the FMU's fmi2GetDirectionalDerivative
+    instead of difference quotients. The class fmpy.simulate_fmu makes (patched
+    in by exchange_run); the instance it made last is its `last`."""
+    import ctypes
+    from fmpy import sundials
+    from fmpy.sundials.libraries import sundials_cvode, sundials_sunmatrixdense
+
+    counters = {name: getattr(sundials_cvode, "CVodeGet" + name) for name in
+                ("NumSteps", "NumRhsEvals", "NumJacEvals", "NumLinRhsEvals")}
+    for fn in counters.values():
+        fn.argtypes, fn.restype = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_long)], ctypes.c_int
+    set_jacobian = sundials_cvode.CVodeSetJacFn
+    vector, matrix = sundials.N_Vector, sundials.SUNMatrix
+    jacobian_type = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, vector, vector, matrix, ctypes.c_void_p,
+                                     vector, vector, vector)
+    set_jacobian.argtypes, set_jacobian.restype = [ctypes.c_void_p, jacobian_type], ctypes.c_int
+    matrix_data = sundials_sunmatrixdense.SUNDenseMatrix_Data
+    matrix_data.argtypes, matrix_data.restype = [matrix], ctypes.c_void_p
+
+    class Counting(sundials.CVodeSolver):
+        jacobian = False
+        model_description = None
+        last = None
+
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            self.totals = dict.fromkeys(counters, 0)
+            type(self).last = self
+            if self.jacobian:
+                self.use_directional_derivatives(kwargs["set_time"].__self__)  # fmpy's FMU2Model
+
+        def use_directional_derivatives(self, fmu):
+            states = [d.variable.derivative.valueReference for d in self.model_description.derivatives]
+            n = len(states)
+            unknowns = (ctypes.c_uint * n)(*(d.variable.valueReference for d in self.model_description.derivatives))
+            known, seed = ctypes.c_uint(), ctypes.c_double(1.0)
+            directional = fmu.dll.fmi2GetDirectionalDerivative
+            directional.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p,
+                                    ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+            directional.restype = ctypes.c_int
+
+            def jacobian(t, y, fy, jac, user_data, tmp1, tmp2, tmp3):
+                self.set_time(t)
+                self.set_x(sundials.NV_DATA_S(y), n)
+                column = matrix_data(jac)
+                for j, vr in enumerate(states):  # the matrix's columns follow each other
+                    known.value = vr
+                    if directional(fmu.component, unknowns, n, ctypes.byref(known), 1, ctypes.byref(seed),
+                                   column + 8 * n * j) != 0:
+                        return -1
+                return 0
+
+            self.jacobian_ = jacobian_type(jacobian)
+            assert set_jacobian(self.cvode_mem, self.jacobian_) == 0
+
+        def live(self):
+            value = ctypes.c_long()
+            found = {}
+            for name, fn in counters.items():
+                fn(self.cvode_mem, ctypes.byref(value))
+                found[name] = value.value
+            return found
+
+        def reset(self, time):  # CVodeReInit starts the counts again
+            for name, value in self.live().items():
+                self.totals[name] += value
+            return super().reset(time)
+
+        def counts(self):
+            return {name: self.totals[name] + value for name, value in self.live().items()}
+
+    return Counting
+
+
+def exchange_run(folder, model_description, rtol, jacobian=False, **start):
+    """One Model Exchange run of the h20 drop test (law 2) in fmpy's CVode:
+    its final row, and CVode's counts."""
+    from unittest import mock
+    from fmpy import simulate_fmu, sundials
+    counting = cvode_counting()
+    counting.jacobian, counting.model_description = jacobian, model_description
+    with mock.patch.object(sundials, "CVodeSolver", counting):
+        r = simulate_fmu(folder, fmi_type="ModelExchange", solver="CVode", relative_tolerance=rtol,
+                         stop_time=EXCHANGE_STOP, output_interval=EXCHANGE_INTERVAL,
+                         start_values=dict(law=2, **start), output=["F_peak", "eps", "x2"],
+                         model_description=model_description)
+    return r[-1], counting.last.counts()
+
+
+def cosim_run(folder, model_description, tolerance):
+    """The co-simulation FMU on the same impact and communication points:
+    the error-controlled steps (ESDIRK 5(4)) at `tolerance`."""
+    from fmpy import simulate_fmu
+    r = simulate_fmu(folder, stop_time=EXCHANGE_STOP, output_interval=EXCHANGE_INTERVAL,
+                     start_values=dict(law=2, tolerance=tolerance), output=["F_peak", "eps", "x2"],
+                     model_description=model_description)
+    return r[-1]
+
+
+def exchange_rows(program, fmu_file):
+    """The h20 impact by Model Exchange (CVode) against co-simulation, each at
+    the coarsest setting whose F_peak stays within TARGET of GSL's, timed side
+    by side; the compressed springpot in Model Exchange with and without the
+    directional derivatives."""
+    from fmpy import extract, read_model_description
+    folder = extract(str(fmu_file or fmu.fmu_path()))
+    md = read_model_description(folder)
+    F_peak = solve(program, "--reference", "--law", "hertz")["F_peak"]
+    error = lambda row: abs(row["F_peak"] / F_peak - 1.0)
+    me_errors = {rtol: error(exchange_run(folder, md, rtol)[0]) for rtol in EXCHANGE_RTOLS}
+    cs_errors = {tol: error(cosim_run(folder, md, tol)) for tol in COSIM_TOLERANCES}
+    rtol = first_setting_that_stays_within(EXCHANGE_RTOLS, me_errors.get)
+    tol = first_setting_that_stays_within(COSIM_TOLERANCES, cs_errors.get)
+    me_cpu, cs_cpu = [], []
+    for _ in range(REPEATS):  # alternating, so that the machine's load falls on both alike
+        me_cpu.append(median_cpu(lambda: exchange_run(folder, md, rtol), budget=1.0, at_least=3))
+        cs_cpu.append(median_cpu(lambda: cosim_run(folder, md, tol), budget=1.0, at_least=3))
+    h20 = dict(rtol=rtol, tolerance=tol, me_error=me_errors[rtol], cs_error=cs_errors[tol],
+               me_cpu=float(np.median(me_cpu)), cs_cpu=float(np.median(cs_cpu)),
+               me_counts=exchange_run(folder, md, rtol)[1], me_errors=me_errors, cs_errors=cs_errors)
+    cpu = {False: [], True: []}
+    for _ in range(REPEATS):  # alternating too
+        for jacobian in cpu:
+            cpu[jacobian].append(median_cpu(lambda: exchange_run(folder, md, SPRINGPOT_RTOL, jacobian, damper=2),
+                                            budget=1.0, at_least=3))
+    springpot = {}
+    for jacobian in cpu:
+        row, counts = exchange_run(folder, md, SPRINGPOT_RTOL, jacobian, damper=2)
+        springpot[jacobian] = dict(F_peak=row["F_peak"], eps=row["eps"], cpu=float(np.median(cpu[jacobian])),
+                                   counts=counts)
+    return h20, springpot
+
+
+def exchange_section(h20, springpot):
+    from fmpy import __version__ as fmpy_version
+    c, j = springpot[False], springpot[True]
+    out = [EXCHANGE_BEGIN, "## Model Exchange against co-simulation, and the directional derivatives", "",
+           "Regenerate this section alone, in place: `scripts/report benchmarks --only exchange` (under a minute). "
+           f"The h20 impact (law 2, the dashpot) over {EXCHANGE_STOP * 1e3:g} ms with output points "
+           f"{EXCHANGE_INTERVAL * 1e6:g} us apart, through fmpy {fmpy_version}'s `simulate_fmu` and the FMI 2.0 "
+           "FMU: by Model Exchange, fmpy's CVode (BDF, its Newton matrix by difference quotients), and by co-simulation, the "
+           "FMU's error-controlled steps (ESDIRK 5(4), each output point a communication step); each at the "
+           "coarsest setting from which on every finer one keeps F_peak within 1e-6 of GSL's "
+           "(`fraccontact-solve --reference --law hertz`), CPU time of the whole run, fmpy's Python loop included, "
+           f"medians of {REPEATS} alternating rounds.", "",
+           "| interface | setting | F_peak error | CPU per impact |", "|---|---|---|---|",
+           f"| Model Exchange (CVode) | rtol {h20['rtol']:.0e} | {h20['me_error']:.1e} | "
+           f"{h20['me_cpu'] * 1e3:.1f} ms |",
+           f"| co-simulation | tolerance {h20['tolerance']:.0e} | {h20['cs_error']:.1e} | "
+           f"{h20['cs_cpu'] * 1e3:.1f} ms |", "",
+           f"Model Exchange takes {h20['me_cpu'] / h20['cs_cpu']:.1f}x the co-simulation's CPU here: CVode took "
+           f"{h20['me_counts']['NumSteps']} steps and {h20['me_counts']['NumRhsEvals']} derivative evaluations "
+           f"(and {h20['me_counts']['NumLinRhsEvals']} for {h20['me_counts']['NumJacEvals']} difference-quotient "
+           "Jacobians), each a call from Python into the FMU. The F_peak errors over the ladders:", "",
+           "| setting | Model Exchange (rtol) | co-simulation (tolerance) |", "|---|---|---|"]
+    for rtol, tol in zip(EXCHANGE_RTOLS, COSIM_TOLERANCES):
+        out.append(f"| {rtol:.0e} | {h20['me_errors'][rtol]:.1e} | {h20['cs_errors'][tol]:.1e} |")
+    out += ["", f"The compressed springpot (damper 2, memory 2, its default kernel) in the same drop test by Model "
+            f"Exchange at rtol {SPRINGPOT_RTOL:.0e}, 164 states: CVode's Newton matrix by its difference quotients "
+            "(a derivative evaluation per state and Jacobian) against the FMU's directional derivatives "
+            "(`fmi2GetDirectionalDerivative`, a column per call, through a Jacobian function given to fmpy's "
+            "CVode, which fmpy's `simulate_fmu` does not offer; `reports/benchmarks.py` adds it), CPU medians of "
+            f"{REPEATS} alternating rounds.", "",
+            "| Newton matrix | CPU per impact | steps | derivative evaluations | Jacobians | derivative evaluations "
+            "for Jacobians | F_peak |", "|---|---|---|---|---|---|---|"]
+    for label, r in (("difference quotients", c), ("directional derivatives", j)):
+        k = r["counts"]
+        out.append(f"| {label} | {r['cpu'] * 1e3:.1f} ms | {k['NumSteps']} | {k['NumRhsEvals']} | "
+                   f"{k['NumJacEvals']} | {k['NumLinRhsEvals']} | {r['F_peak']:.9g} N |")
+    out += ["", f"The directional derivatives take {j['cpu'] / c['cpu']:.2f}x the difference quotients' CPU; "
+            f"their F_peak differ by {abs(j['F_peak'] / c['F_peak'] - 1):.1e} (relative), within the host's "
+            "tolerance.", EXCHANGE_END]
+    return out
+
+
 def main(argv=None, prog=None):
     parser = output.parser(prog, __doc__)
     output.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
     output.add_fmu(parser)
-    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions"],
+    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions",
+                                           "exchange"],
                         help="regenerate one section alone, in place (precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
                              "core; springpot: the springpot's memories, and the dashpot against the commit before "
                              "them; controlled: the springpot against the dashpot under error control; "
-                             "instructions: the instruction counts of the guard's runs, and the regression table)")
+                             "instructions: the instruction counts of the guard's runs, and the regression table; "
+                             "exchange: Model Exchange against co-simulation, and with and without the directional "
+                             "derivatives)")
     parser.add_argument("--largest-n", type=float, default=1e6,
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = output.parse(parser, argv)
@@ -1369,6 +1561,12 @@ def main(argv=None, prog=None):
         replace_section(args.out / "benchmarks.md", section, INSTRUCTIONS_BEGIN, INSTRUCTIONS_END)
         print((args.out / "benchmarks.md").read_text())
         return
+    if args.only == "exchange":
+        say("Model Exchange ...")
+        replace_section(args.out / "benchmarks.md", exchange_section(*exchange_rows(program, args.fmu)),
+                        EXCHANGE_BEGIN, EXCHANGE_END)
+        print((args.out / "benchmarks.md").read_text())
+        return
     root = source_tree()
     say("1/5 cost of a step ...")
     steps = step_costs(bench)
@@ -1383,5 +1581,8 @@ def main(argv=None, prog=None):
     say("the springpot under error control ...")
     controlled = controlled_section(*controlled_rows(bench))
     write(args.out / "benchmarks.md", steps, precision_lines, g1, -0.5, package, springpot, controlled)
+    say("Model Exchange ...")
+    replace_section(args.out / "benchmarks.md", exchange_section(*exchange_rows(program, args.fmu)), EXCHANGE_BEGIN,
+                    EXCHANGE_END)
     print((args.out / "benchmarks.md").read_text())
 

@@ -314,7 +314,8 @@ def test_the_call_sequence_is_enforced(instance):
     do_step = i.fmu.dll.fmi2DoStep
     do_step.argtypes, do_step.restype = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int], ctypes.c_int
     assert do_step(i.fmu.component, 0.0, 1e-5, 1) == 3  # fmi2Error
-    assert "fmi2DoStep: illegal call sequence: called in state Continuous-Time Mode" in i.log[-1]
+    assert i.log[-1].startswith("fmi2DoStep is a function of co-simulation: this instance was made for "
+                                "fmi2ModelExchange"), i.log[-1]
     i.set_states(i.states())
 
 
@@ -341,35 +342,37 @@ def test_the_fmu_state_restores_the_continuous_states(instance):
     i.fmu.freeFMUstate(saved)
 
 
+STATE_NAMES = ["x", "v_striker", "x2", "E_diss"] + [f"phi[{m + 1}]" for m in range(160)]
+DERIVATIVES = [f"der({name})" for name in STATE_NAMES]
+
+
 def jacobian_columns(i, x, knowns):
-    """Per known (a state's place, or "v"): the directional derivative of
-    all the derivatives, and the central difference of the derivatives over
-    1e-4 of the known's scale (the state's size here)."""
-    names = [v for v in i.vr if v.startswith("der(")]
-    unknowns = [i.vr[n] for n in names]
-    place = {n: k for k, n in enumerate(["der(x)", "der(v_striker)", "der(x2)", "der(E_diss)"]
-                                       + [f"der(phi[{m + 1}])" for m in range(160)])}
-    state_vr = [i.vr[n] for n in ["x", "v_striker", "x2", "E_diss"] + [f"phi[{m + 1}]" for m in range(160)]]
+    """Per known (a state's place, or an input's name, "v" or "v2"): the
+    directional derivative of all the derivatives, in the states' order,
+    and the central difference of the derivatives over 1e-4 of the
+    known's scale (the state's or the input's size here, at least 1e-7 m
+    or 0.1 m/s)."""
+    unknowns = [i.vr[n] for n in DERIVATIVES]
     columns = []
     for known in knowns:
-        vr = i.vr["v"] if known == "v" else state_vr[known]
+        vr = i.vr[known] if isinstance(known, str) else i.vr[STATE_NAMES[known]]
         exact = np.array(i.fmu.getDirectionalDerivative(unknowns, [vr], [1.0]))
-        h = 1e-4 * (0.1 if known == "v" else max(abs(x[known]), 1e-7))
+        value = i.get(known) if isinstance(known, str) else x[known]
+        h = 1e-4 * max(abs(value), 0.1 if isinstance(known, str) else 1e-7)
         sides = []
         for sign in (1, -1):
-            if known == "v":
-                i.fmu.setReal([vr], [0.1 + sign * h])
+            if isinstance(known, str):
+                i.fmu.setReal([vr], [value + sign * h])
                 i.set_states(x)
             else:
                 y = x.copy()
                 y[known] += sign * h
                 i.set_states(y)
             sides.append(i.derivatives())
-        if known == "v":
-            i.fmu.setReal([vr], [0.1])
+        if isinstance(known, str):
+            i.fmu.setReal([vr], [value])
         i.set_states(x)
-        difference = (sides[0] - sides[1]) / (2 * h)
-        columns.append((known, exact, np.array([difference[place[n]] for n in names])))
+        columns.append((known, exact, (sides[0] - sides[1]) / (2 * h)))
     return columns
 
 
@@ -399,6 +402,63 @@ def test_directional_derivatives_name_what_they_take(instance):
     with pytest.raises(Exception):
         i.fmu.getDirectionalDerivative([i.vr["der(x)"]], [i.vr["k"]], [1.0])
     assert "value reference 8 is not a continuous state or the input v or v2" in i.log[-1]
+
+
+def declared_dependencies(model_description):
+    """ModelStructure's Derivatives: {der(name): {known's name: its dependenciesKind}}."""
+    return {u.variable.name: dict(zip((v.name for v in u.dependencies), u.dependenciesKind))
+            for u in model_description.derivatives}
+
+
+# The drop test and the driven scene, the dashpot and the springpot: the
+# first springpot's kernel has all 160 modes (the tightest kernel, the
+# shortest step), the second's fewer.
+SCENES = [dict(law=2), dict(law=2, damper=2, memory_tolerance=1e-12, dt_max=1e-10),
+          dict(law=2, scene=2, v=0.1, m=0.0), dict(law=2, damper=2, scene=2, v=0.1, m=0.0)]
+
+
+def in_contact(shift):
+    """States in contact, the modes stretched unevenly; shift moves them all."""
+    x = np.zeros(STATES)
+    x[:4] = [2e-4 + shift, 0.3 - 1e3 * shift, 5e-5 + 0.3 * shift, 0.01]
+    x[4:] = np.linspace(1e-6, 2e-5, 160) * (1 + 1e4 * shift)
+    return x
+
+
+def test_the_declared_dependencies_are_the_jacobians_pattern(instance, model_description):
+    """The Derivatives' dependencies (docs/model_exchange.md) against the
+    Jacobian: over the four scenes, at two states each, every entry the
+    directional derivatives give nonzero is declared, and every declared
+    one is nonzero in a scene; the central differences are nonzero at the
+    same entries (a rate that does not read a known does not move with it:
+    exactly 0). A dependency declared fixed keeps its factor from one state
+    to the other, to the bit (no rounding enters a factor that the state
+    does not); each declared dependent moves in a scene. The FMI 3.0 FMU
+    declares the same, by name."""
+    from fmpy import read_model_description
+    declared = declared_dependencies(model_description)
+    assert list(declared) == DERIVATIVES
+    assert declared == declared_dependencies(read_model_description(str(FMU3)))
+    knowns = list(range(STATES)) + ["v", "v2"]
+    names = STATE_NAMES + ["v", "v2"]
+    seen, moved = set(), set()
+    for values in SCENES:
+        i = instance(**values).start()
+        factors = []
+        for shift in (0.0, 1e-5):
+            x = in_contact(shift)
+            i.set_states(x)
+            columns = jacobian_columns(i, x, knowns)
+            exact = np.array([c[1] for c in columns]).T  # row: a derivative, column: a known
+            difference = np.array([c[2] for c in columns]).T
+            assert ((exact != 0) == (difference != 0)).all(), values
+            seen |= {(DERIVATIVES[r], names[c]) for r, c in zip(*np.nonzero(exact))}
+            factors.append(exact)
+        moved |= {(DERIVATIVES[r], names[c]) for r, c in zip(*np.nonzero(factors[0] != factors[1]))}
+    pairs = {(d, k): kind for d, knowns_of in declared.items() for k, kind in knowns_of.items()}
+    assert set(pairs) == seen
+    assert {pair for pair, kind in pairs.items() if kind == "dependent"} == moved
+    assert set(pairs.values()) == {"dependent", "fixed"}
 
 
 def test_a_state_the_host_set_restores_in_a_new_instance(instance):
@@ -477,6 +537,60 @@ def test_the_fmi3_fmu_refuses_restores_and_counts_as_the_fmi2_one(model_descript
     assert np.max(np.abs(column - difference)) <= 1e-7 * np.max(np.abs(column))
     fmu.terminate()
     fmu.freeInstance()
+
+
+def test_an_fmi3_model_exchange_instance_speaks_of_model_exchange(model_description):
+    """The refusals of an FMI 3.0 instance for Model Exchange name the
+    function that made it, its calls and its states, never co-simulation's
+    own (fmi3InstantiateCoSimulation, Step Mode, communication steps); a
+    co-simulation function called on it says what it is and what to call
+    instead. An impact's end is logged without counting communication
+    steps."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi3 import FMU3Model
+    md = read_model_description(str(FMU3))
+    folder = extract(str(FMU3))
+    said = []
+    log = lambda env, status, category, message: said.append(message.decode())
+    for name, guid, rule in (("", md.guid, "instanceName must be a non-empty string"),
+                             ("me3", "{not the token}", "instantiationToken does not match")):
+        made = FMU3Model(guid=guid, unzipDirectory=folder, modelIdentifier=md.modelExchange.modelIdentifier,
+                         instanceName=name)
+        with pytest.raises(Exception):
+            made.instantiate(logMessage=log)
+        assert said[-1].startswith("fmi3InstantiateModelExchange: " + rule), said
+    fmu = FMU3Model(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.modelExchange.modelIdentifier,
+                    instanceName="me3")
+    fmu.instantiate(loggingOn=True, logMessage=log)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu.enterInitializationMode()
+    fmu.setInt32([vr["law"]], [2])
+    fmu.exitInitializationMode()
+    pointer = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    x = np.zeros(STATES)
+    with pytest.raises(Exception):
+        fmu.setContinuousStates(pointer(x), STATES)
+    assert said[-1] == ("fmi3SetContinuousStates: illegal call sequence: called in state Event Mode, allowed only "
+                        "in Continuous-Time Mode"), said[-1]
+    for call, args in (("fmi3EnterStepMode", ()), ("fmi3DoStep", (0.0, 1e-6, False, None, None, None, None))):
+        with pytest.raises(Exception):
+            getattr(fmu, call)(fmu.component, *args)
+        assert said[-1].startswith(call + " is a function of co-simulation: this instance was made by "
+                                   "fmi3InstantiateModelExchange"), said[-1]
+    fmu.updateDiscreteStates()
+    fmu.enterContinuousTimeMode()
+    fmu.getContinuousStates(pointer(x), STATES)
+    for total, velocity in ((2e-4, 0.3), (-1e-6, -0.3)):  # into contact, then out of it
+        x[:2] = total, velocity
+        fmu.setContinuousStates(pointer(x), STATES)
+        fmu.enterEventMode()
+        fmu.updateDiscreteStates()
+        fmu.enterContinuousTimeMode()
+    assert any(m.startswith("impact 1 ended at t = 0 s") for m in said), said
+    fmu.terminate()
+    fmu.freeInstance()
+    for word in ("CoSimulation", "Step Mode", "communication step"):
+        assert not [m for m in said if word in m and "is a function of co-simulation" not in m], word
 
 
 def test_the_nominals_are_the_impacts_scales(instance):

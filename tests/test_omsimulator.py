@@ -5,11 +5,13 @@ other masters' annotation carries) and stay SSP 1.0; where it is installed
 masters and the references do, and `fraccontact scene --master omsimulator`
 prints the figures."""
 
+import ctypes
 import json
 import os
 import pathlib
 import subprocess
 import sys
+import tempfile
 import zipfile
 
 import numpy as np
@@ -188,3 +190,86 @@ def test_a_scene_of_exported_contacts_gives_omsimulator_the_shipped_scenes_figur
                      for path in (SSPS["headform"], exported))
     assert shipped.returncode == 0 and ours.returncode == 0, (shipped.stderr, ours.stderr)
     assert json.loads(ours.stdout) == json.loads(shipped.stdout)
+
+
+# ------------------------------------------------------------ Model Exchange
+
+def exchange_in_omsimulator(fmu, stop_time, values, read):
+    """The FMU alone in a strongly coupled system (OMSimulator imports an FMU
+    there for Model Exchange and integrates it with its own CVode) at
+    tolerance 1e-10: the variables `read` at stop_time."""
+    lib = omsimulator.load()
+    text, real, integer = ctypes.c_char_p, ctypes.c_double, ctypes.c_int
+    for name, args in (("oms_newModel", [text]), ("oms_addSystem", [text, integer]),
+                       ("oms_addSubModel", [text, text]), ("oms_setSolver", [text, integer]),
+                       ("oms_setTolerance", [text, real]), ("oms_simulate", [text])):
+        getattr(lib, name).argtypes, getattr(lib, name).restype = args, integer
+    system_sc, solver_cvode = 2, 3  # oms_system_enu_t, oms_solver_enu_t (OMSimulator/Types.h)
+    value, found = ctypes.c_double(), {}
+    with omsimulator.quiet(), tempfile.TemporaryDirectory(prefix="fraccontact-omsimulator-") as folder:
+        # its own: OMSimulator keeps the last one set, which an earlier run may have removed
+        omsimulator.call(lib, "oms_setTempDirectory", folder.encode())
+        omsimulator.call(lib, "oms_newModel", b"me")
+        try:
+            omsimulator.call(lib, "oms_addSystem", b"me.root", system_sc)
+            omsimulator.call(lib, "oms_addSubModel", b"me.root.contact", str(fmu).encode())
+            omsimulator.call(lib, "oms_setSolver", b"me.root", solver_cvode)
+            omsimulator.call(lib, "oms_setTolerance", b"me.root", 1e-10)
+            omsimulator.call(lib, "oms_setResultFile", b"me", b"", 0)
+            omsimulator.call(lib, "oms_setStopTime", b"me", stop_time)
+            for name, v in values.items():
+                setter = "oms_setInteger" if isinstance(v, int) else "oms_setReal"
+                omsimulator.call(lib, setter, f"me.root.contact.{name}".encode(), v)
+            omsimulator.call(lib, "oms_instantiate", b"me")
+            omsimulator.call(lib, "oms_initialize", b"me")
+            omsimulator.call(lib, "oms_simulate", b"me")
+            for name in read:
+                omsimulator.call(lib, "oms_getReal", f"me.root.contact.{name}".encode(), ctypes.byref(value))
+                found[name] = value.value
+            omsimulator.call(lib, "oms_terminate", b"me")
+        finally:
+            lib.oms_delete(b"me")
+    return found
+
+
+def solve_reference(*args):
+    """fraccontact-solve --reference (GSL, rtol 1e-12) of law 2."""
+    solve = os.environ.get("FRACCONTACT_SOLVE", str(fmu_path().parent / "fraccontact-solve"))
+    done = subprocess.run([solve, "--reference", "--json", "--law", "hertz", *map(str, args)], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+@installed
+@pytest.mark.parametrize("bodies", [{}, dict(v=3.0, m=0.7437, v2=1.0, m2=2.0)], ids=["h20", "two_bodies"])
+def test_omsimulator_integrates_the_model_exchange_fmu_as_the_reference(bodies):
+    """The FMI 2.0 FMU (OMSimulator reads no FMI 3.0 FMU in a strongly
+    coupled system) in OMSimulator's CVode at 1e-10: F_peak, x2, E_diss
+    and the contact time within 1e-6 (relative), eps within 1e-6, of GSL's
+    solve, as fmpy's CVode at the same tolerance (docs/model_exchange.md).
+    The contact time from the free flight after the separation, the striker
+    starting on the surface (gap0 = 0, g = 0): x1 = x - x2 falls at the
+    constant approach speed v_striker from 0 at the separation."""
+    stop = 2e-3
+    got = exchange_in_omsimulator(fmu_path(), stop, dict(law=2, **bodies),
+                                  ("F_peak", "eps", "x", "x2", "E_diss", "v_striker"))
+    want = solve_reference(*sum((["--" + k, v] for k, v in bodies.items()), []))
+    t_contact = stop - (got["x"] - got["x2"]) / got["v_striker"]
+    assert got["v_striker"] < 0 and got["x"] < got["x2"]  # separated, flying off
+    for found, key in ((got["F_peak"], "F_peak"), (got["x2"], "x2_end"), (got["E_diss"], "E_diss"),
+                       (t_contact, "t_contact")):
+        assert abs(found / want[key] - 1.0) < 1e-6, (key, found, want[key])
+    assert abs(got["eps"] - want["eps"]) < 1e-6
+
+
+@installed
+def test_omsimulator_drives_the_model_exchange_fmu_as_the_reference():
+    """The driven scene (the indentation at the input rate v = 0.1 m/s, no
+    striker inertia) to t = 1 ms: force, dent and dissipated work as GSL's."""
+    t_end = 1e-3
+    got = exchange_in_omsimulator(fmu_path(), t_end, dict(law=2, scene=2, v=0.1, m=0.0),
+                                  ("F_peak", "x", "x2", "E_diss"))
+    want = solve_reference("--scene", "driven", "--v", 0.1, "--m", 0, "--t-end", t_end)["end"]
+    for key in ("F_peak", "x", "x2", "E_diss"):
+        assert abs(got[key] / want[key] - 1.0) < 1e-6, (key, got[key], want[key])

@@ -368,7 +368,8 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
     fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why)
-        || contact_step_warning(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why)
+        || (!fm->model_exchange /* the host's solver takes the steps */
+            && contact_step_warning(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why))
         || contact_arrival_warning(&fm->params, approach(&fm->in), why, sizeof why))
         return report(fm, FM_WARNING, "logStatusWarning", "%s", why);
     if (other_accel(&fm->in) != 0.0 && fm->params.scene == CONTACT_SCENE_DROP)
@@ -408,7 +409,10 @@ static void restore_memory(contact_model *cm, const memory_copy *copy)
 static void report_events(fmu_model *fm, const contact_state *before)
 {
     const contact_state *s = &fm->model.s;
-    if (s->impacts != before->impacts)
+    if (s->impacts != before->impacts && fm->model_exchange) /* no communication steps to count */
+        report(fm, FM_OK, "logEvents", "impact %" PRId64 " ended at t = %.9g s: eps = %.6g, x2 = %.6g m, "
+               "F_peak = %.6g N", s->impacts, s->t, s->eps, s->x2, s->F_peak);
+    else if (s->impacts != before->impacts)
         report(fm, FM_OK, "logEvents",
                "impact %" PRId64 " ended by t = %.9g s: eps = %.6g, x2 = %.6g m, F_peak = %.6g N; "
                "communication steps so far: %" PRId64 " taken from the prediction, %" PRId64 " computed",

@@ -61,6 +61,13 @@ static void send_log(const fmu_instance *base, fi_status status, const char *cat
 
 #define fail(in, ...) ((fmi2Status)fi_fail(&(in)->base, __VA_ARGS__))
 
+/* A co-simulation function called on a Model Exchange instance. */
+#define CO_SIMULATION_ONLY(name) \
+    if (in && in->base.model_exchange) \
+        return fail(in, "%s is a function of co-simulation: this instance was made for fmi2ModelExchange, the " \
+                        "host's solver integrates it (fmi2SetTime, fmi2SetContinuousStates, fmi2GetDerivatives)", \
+                    (name))
+
 /* ---------------------------------------------------------------- instances */
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -291,6 +298,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     instance *in = c;
     const double t = currentCommunicationPoint, H = communicationStepSize;
     (void)noSetFMUStatePriorToCurrentPoint;
+    CO_SIMULATION_ONLY("fmi2DoStep");
     REQUIRE(STEP_COMPLETE, "fmi2DoStep");
     if (fi_check_step(&in->base, t, H, 1, "fmi2DoStep") != FI_OK)
         return fmi2Error;
@@ -300,6 +308,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 fmi2Status fmi2CancelStep(fmi2Component c)
 {
     instance *in = c;
+    CO_SIMULATION_ONLY("fmi2CancelStep");
     REQUIRE(0, "fmi2CancelStep"); /* steps are synchronous: never in progress */
     return fmi2Error;
 }
@@ -309,6 +318,7 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
     instance *in = c;
     (void)s;
     (void)value;
+    CO_SIMULATION_ONLY("fmi2GetStatus");
     REQUIRE(STEPPING, "fmi2GetStatus");
     return fmi2Discard; /* no asynchronous step, so no pending status */
 }
@@ -316,6 +326,7 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
     instance *in = c;
+    CO_SIMULATION_ONLY("fmi2GetRealStatus");
     REQUIRE(STEPPING, "fmi2GetRealStatus");
     if (s != fmi2LastSuccessfulTime || !value)
         return fmi2Discard;
@@ -328,6 +339,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
     instance *in = c;
     (void)s;
     (void)value;
+    CO_SIMULATION_ONLY("fmi2GetIntegerStatus");
     REQUIRE(STEPPING, "fmi2GetIntegerStatus");
     return fmi2Discard;
 }
@@ -335,6 +347,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
     instance *in = c;
+    CO_SIMULATION_ONLY("fmi2GetBooleanStatus");
     REQUIRE(STEPPING, "fmi2GetBooleanStatus");
     if (s != fmi2Terminated || !value)
         return fmi2Discard;
@@ -347,6 +360,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     instance *in = c;
     (void)s;
     (void)value;
+    CO_SIMULATION_ONLY("fmi2GetStringStatus");
     REQUIRE(STEPPING, "fmi2GetStringStatus");
     return fmi2Discard;
 }
@@ -437,6 +451,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
 {
     instance *in = c;
     size_t i;
+    CO_SIMULATION_ONLY("fmi2SetRealInputDerivatives");
     REQUIRE(SETTABLE, "fmi2SetRealInputDerivatives");
     if (fi_null_arrays(&in->base, nvr, vr, value, "fmi2SetRealInputDerivatives")
         || fi_null_arrays(&in->base, nvr, order, order, "fmi2SetRealInputDerivatives"))
@@ -452,6 +467,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 {
     instance *in = c;
     size_t i;
+    CO_SIMULATION_ONLY("fmi2GetRealOutputDerivatives");
     REQUIRE(STEPPING, "fmi2GetRealOutputDerivatives");
     if (fi_null_arrays(&in->base, nvr, vr, value, "fmi2GetRealOutputDerivatives")
         || fi_null_arrays(&in->base, nvr, order, order, "fmi2GetRealOutputDerivatives"))

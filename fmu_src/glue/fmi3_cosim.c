@@ -6,6 +6,7 @@
  * too (FMU_MODEL_EXCHANGE), the instances, event mode, variables and FMU
  * state here serve it as well, and fmi3_me.c has its own functions. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -55,42 +56,47 @@ static void send_log(const fmu_instance *base, fi_status status, const char *cat
 
 #define fail(in, ...) ((fmi3Status)fi_fail(&(in)->base, __VA_ARGS__))
 
+/* A co-simulation function called on a Model Exchange instance. */
+#define CO_SIMULATION_ONLY(name) \
+    if (in && in->base.model_exchange) \
+        return fail(in, "%s is a function of co-simulation: this instance was made by fmi3InstantiateModelExchange, " \
+                        "the host's solver integrates it (fmi3SetTime, fmi3SetContinuousStates, " \
+                        "fmi3GetContinuousStateDerivatives)", (name))
+
 /* ---------------------------------------------------------------- instances */
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
 
-fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
-                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
-                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
-                                         const fmi3ValueReference requiredIntermediateVariables[],
-                                         size_t nRequiredIntermediateVariables,
-                                         fmi3InstanceEnvironment instanceEnvironment,
-                                         fmi3LogMessageCallback logMessage,
-                                         fmi3IntermediateUpdateCallback intermediateUpdate)
+/* An instance, its messages naming `name`, the function that makes it
+ * (fmi3InstantiateCoSimulation, or fmi3InstantiateModelExchange with
+ * event mode used and no intermediate update), or NULL and a message. */
+static instance *instantiate(const char *name, fmi3String instanceName, fmi3String instantiationToken,
+                             fmi3String resourcePath, fmi3Boolean loggingOn, fmi3Boolean eventModeUsed,
+                             fmi3Boolean earlyReturnAllowed, size_t nRequiredIntermediateVariables,
+                             fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
+                             fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     instance probe, *in;
-    (void)visible;
-    (void)requiredIntermediateVariables;
+    char token[64];
     probe.environment = instanceEnvironment;
     probe.log_message = logMessage;
     fi_probe(&probe.base, instanceName, send_log);
     if (!instanceName || !*instanceName) {
-        fail(&probe, "fmi3InstantiateCoSimulation: instanceName must be a non-empty string");
+        fail(&probe, "%s: instanceName must be a non-empty string", name);
         return NULL;
     }
     if (!instantiationToken) {
-        fail(&probe, "fmi3InstantiateCoSimulation: instantiationToken does not match modelDescription.xml (" FMU_GUID
-                     ")");
+        fail(&probe, "%s: instantiationToken does not match modelDescription.xml (" FMU_GUID ")", name);
         return NULL;
     }
     if (nRequiredIntermediateVariables > 0) {
-        fail(&probe, "fmi3InstantiateCoSimulation: nRequiredIntermediateVariables = %lu, but no variable of this FMU "
-                     "can be read or set during an intermediate update", (unsigned long)nRequiredIntermediateVariables);
+        fail(&probe, "%s: nRequiredIntermediateVariables = %lu, but no variable of this FMU can be read or set "
+                     "during an intermediate update", name, (unsigned long)nRequiredIntermediateVariables);
         return NULL;
     }
     in = calloc(1, sizeof *in);
     if (!in) {
-        fail(&probe, "fmi3InstantiateCoSimulation: out of memory");
+        fail(&probe, "%s: out of memory", name);
         return NULL;
     }
     *in = probe;
@@ -101,12 +107,29 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         free(in);
         return NULL;
     }
-    if (!fv_load(&in->base, resourcePath, 0, "fmi3InstantiateCoSimulation", instantiationToken, "fmi3InstantiateCoSimulation: instantiationToken")) {
+    snprintf(token, sizeof token, "%s: instantiationToken", name);
+    if (!fv_load(&in->base, resourcePath, 0, name, instantiationToken, token)) {
         fi_release(&in->base);
         free(in);
         return NULL;
     }
     return in;
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
+                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
+                                         const fmi3ValueReference requiredIntermediateVariables[],
+                                         size_t nRequiredIntermediateVariables,
+                                         fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage,
+                                         fmi3IntermediateUpdateCallback intermediateUpdate)
+{
+    (void)visible;
+    (void)requiredIntermediateVariables;
+    return instantiate("fmi3InstantiateCoSimulation", instanceName, instantiationToken, resourcePath, loggingOn,
+                       eventModeUsed, earlyReturnAllowed, nRequiredIntermediateVariables, instanceEnvironment,
+                       logMessage, intermediateUpdate);
 }
 
 static fmi3Instance other_interface(fmi3String instanceName, fmi3InstanceEnvironment environment,
@@ -132,8 +155,9 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage)
 {
-    instance *in = fmi3InstantiateCoSimulation(instanceName, instantiationToken, resourcePath, visible, loggingOn,
-                                               fmi3True, fmi3False, NULL, 0, instanceEnvironment, logMessage, NULL);
+    instance *in = instantiate("fmi3InstantiateModelExchange", instanceName, instantiationToken, resourcePath,
+                               loggingOn, fmi3True, fmi3False, 0, instanceEnvironment, logMessage, NULL);
+    (void)visible;
     if (in) {
         in->base.model_exchange = 1;
         fm_me_instantiated(in->base.fm);
@@ -267,9 +291,8 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesN
 fmi3Status fmi3EnterStepMode(fmi3Instance c)
 {
     instance *in = c;
+    CO_SIMULATION_ONLY("fmi3EnterStepMode");
     REQUIRE(EVENT_MODE, "fmi3EnterStepMode");
-    if (in->base.model_exchange)
-        return fail(in, "fmi3EnterStepMode: the instance was instantiated for model exchange, not co-simulation");
     in->base.state = STEP_MODE;
     return fmi3OK;
 }
@@ -510,6 +533,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     double now = t;
     int event = 0;
     (void)noSetFMUStatePriorToCurrentPoint;
+    CO_SIMULATION_ONLY("fmi3DoStep");
     REQUIRE(STEP_MODE, "fmi3DoStep");
     stop = in->early_return_allowed || in->intermediate_update ? FM_STOP_AT_EVENT : 0u;
     options = stop;
@@ -551,6 +575,7 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[
 {
     instance *in = c;
     size_t i;
+    CO_SIMULATION_ONLY("fmi3GetOutputDerivatives");
     REQUIRE(STEP_MODE | TERMINATED, "fmi3GetOutputDerivatives");
     if (!scalars(in, nvr, vr, values, nValues, "fmi3GetOutputDerivatives")
         || fi_null_arrays(&in->base, nvr, orders, orders, "fmi3GetOutputDerivatives"))
