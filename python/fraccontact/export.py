@@ -35,7 +35,7 @@ import zipfile
 
 from . import model
 from .atomic import replacing
-from .fixed_values import FIXED_VALUES
+from .fixed_values import FIXED_VALUES, OMIT
 from .options import OneLineParser
 from .shipped import fmu_path
 
@@ -222,7 +222,8 @@ def spelled(variable, value):
 
 def fixed_values_text(variables, exposed, values, title):
     """The resources file: every hidden parameter and input at its value (given or the full FMU's start), and
-    every exposed one given a value, its start in the exported FMU; in the order of modelDescription.xml."""
+    every exposed one given a value, its start in the exported FMU; in the order of modelDescription.xml; then
+    a line "omit NAME" for each output left out (without F_avg_next the binary keeps no prediction)."""
     lines = [f"# {line}" for line in title] + ["# name value (fmu_src/glue/fixed_values.c reads it at "
                                                 "instantiation)"]
     for v in variables:
@@ -230,6 +231,7 @@ def fixed_values_text(variables, exposed, values, title):
             continue
         value = values[v.name] if v.name in values else value_of(v, v.typed.get("start"))
         lines.append(f"{v.name} {spelled(v, value)}{'  # its start: tunable' if v.name in exposed else ''}")
+    lines += [f"{OMIT} {v.name}" for v in variables if v.causality == "output" and v.name not in exposed]
     return "\n".join(lines + ["end", ""])
 
 
