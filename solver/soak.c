@@ -242,14 +242,15 @@ static size_t heap_bytes(void)
 
 /* An instance of the FMU of `guid` (its resources folder's URI; "" for
  * none), given `ints` for damper and memory and `reals` for
- * memory_tolerance unless NULL, initialized; NULL after a message. */
+ * memory_tolerance unless NULL, initialized (a warning of a value without
+ * effect allowed); NULL after a message. */
 static fmi2Component started(const char *guid, const char *resources, const fmi2Integer *ints,
                              const fmi2Real *reals)
 {
     const fmi2ValueReference vr_int[] = {VR_damper, VR_memory}, vr_real[] = {VR_memory_tolerance};
     fmi2Component x = fmi2Instantiate("soak", fmi2CoSimulation, guid, resources, &callbacks, fmi2False, fmi2False);
     if (!x || (ints && (fmi2SetInteger(x, vr_int, 2, ints) != fmi2OK || fmi2SetReal(x, vr_real, 1, reals) != fmi2OK))
-        || fmi2EnterInitializationMode(x) != fmi2OK || fmi2ExitInitializationMode(x) != fmi2OK) {
+        || fmi2EnterInitializationMode(x) != fmi2OK || fmi2ExitInitializationMode(x) > fmi2Warning) {
         fprintf(stderr, "fraccontact-soak: an instance did not start\n");
         return NULL;
     }

@@ -191,6 +191,9 @@ HOSTILE = [
     ("end\nc 1\n", 'line 2: text after the line "end"'),
     ("guid {a}\nguid {b}\nend\n", "line 2: guid is already set on line 1; it takes one line"),
     ("c 1\0\nend\n", "holds a NUL byte"),
+    ("omit c\nend\n", "line 1: omit c: an input or a parameter, which the FMU has to offer"),
+    ("omit cc\nend\n", "line 1: omit cc: no variable of this FMU has that name"),
+    ("omit F\n\nomit F\nend\n", "line 3: omit F: already on line 1"),
     ("#" * 20000 + "\nend\n", "is larger than 16384 bytes"),
 ]
 
@@ -271,6 +274,79 @@ def test_an_exported_fmu_has_its_own_guid_which_its_binary_takes_from_its_file(t
     assert fraccontact.fmu._RECENT[-1][2] == (f"fmi2Instantiate: fmuGUID does not match modelDescription.xml "
                                              f"({full.guid}; an exported FMU names its own in "
                                              f"resources/fixed_values.txt, which this FMU has not)")
+
+
+SOAK = os.environ.get("FRACCONTACT_SOAK", str(ROOT / "build" / "fraccontact-soak"))
+
+
+def soak_memory(*args):
+    done = subprocess.run([SOAK, "memory", *args], capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+@pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                    reason="AddressSanitizer's allocator keeps its own account of the heap")
+def test_a_gauss_seidel_export_keeps_no_prediction_and_holds_what_the_page_says(tmp_path):
+    """A one-body dashpot exported for the drop test (Gauss-Seidel) omits
+    F_avg_next: its instance holds at most 2 KiB, less than the full FMU's
+    by at least the contact model it keeps no second copy of, the page's
+    figures as fraccontact-soak measures them; a Jacobi export omits F_avg
+    and keeps its prediction (no smaller than the full FMU's)."""
+    path = tmp_path / "gs.fmu"
+    out = fraccontact.export(path)  # the h20 drop test's values
+    assert "\nomit F_avg_next\n" in out["fixed"] and "\nomit F_avg\n" not in out["fixed"]
+    folder = tmp_path / "gs"
+    extract(str(path), unzipdir=str(folder))
+    guid = read_model_description(str(path)).guid
+    mine = soak_memory((folder / "resources").as_uri(), guid)["instance_bytes"]
+    full = soak_memory()
+    dashpot = full["configurations"][0]
+    assert (dashpot["damper"], dashpot["memory"]) == (1, 2) and mine <= 2048
+    # the same file without its omission: the prediction back, a contact model and its few scalars, in a
+    # block of its own (malloc's header), less the list entry the omission took
+    (folder / FIXED_VALUES).write_text(out["fixed"].replace("\nomit F_avg_next\n", "\n"))
+    predicting = soak_memory((folder / "resources").as_uri(), guid)["instance_bytes"]
+    assert full["bytes_contact_model"] <= predicting - mine <= full["bytes_contact_model"] + 64
+    said = re.search(r"<!-- export-memory -->([\d,]+) B per instance, against the full FMU's ([\d,]+) "
+                     r"B<!-- /export-memory -->", PAGE)
+    assert said and [int(x.replace(",", "")) for x in said.groups()] == [mine, dashpot["instance_bytes"]]
+    jacobi = tmp_path / "jacobi.fmu"
+    out = fraccontact.export(jacobi, coupling="jacobi")
+    assert "\nomit F_avg\n" in out["fixed"] and "\nomit F_avg_next\n" not in out["fixed"]
+    folder = tmp_path / "jacobi"
+    extract(str(jacobi), unzipdir=str(folder))
+    held = soak_memory((folder / "resources").as_uri(), read_model_description(str(jacobi)).guid)
+    assert held["instance_bytes"] >= dashpot["instance_bytes"]
+
+
+def test_an_instance_without_f_avg_next_refuses_it_and_the_jacobi_coupling(tmp_path):
+    """A file that omits F_avg_next: reading it is an error naming it, before
+    and after a reset (the omission is set again); coupling = 2 is refused
+    when set and, from the file, at initialization; the full FMU reads it."""
+    md = read_model_description(str(FMU2))
+    folder = unpacked_with(tmp_path, FMU2, "omit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=True, instance_name="lean")
+    vr = next(v.valueReference for v in md.modelVariables if v.name == "F_avg_next")
+    for reset in (False, True):
+        if reset:
+            s.fmu.reset()
+            s.enter()
+        with pytest.raises(Exception):
+            s.fmu.getReal([vr])
+        assert fraccontact.fmu._RECENT[-1][2].startswith(f"F_avg_next (value reference {vr}): this exported FMU "
+                                                         "does not offer it"), fraccontact.fmu._RECENT[-1]
+    folder = unpacked_with(tmp_path, FMU2, "end\n")
+    assert len(Slave(md, str(folder), start=True, instance_name="full").fmu.getReal([vr])) == 1
+    folder = unpacked_with(tmp_path, FMU2, "omit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=False, instance_name="set")
+    with pytest.raises(Exception):
+        s.set(coupling=2)
+    assert "coupling = 2 is invalid: this FMU does not offer F_avg_next" in fraccontact.fmu._RECENT[-1][2]
+    folder = unpacked_with(tmp_path, FMU2, "coupling 2\nomit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=False, instance_name="file")
+    with pytest.raises(Exception):
+        s.start()
+    assert "coupling = 2 is invalid: this FMU does not offer F_avg_next" in fraccontact.fmu._RECENT[-1][2]
 
 
 def test_a_reset_sets_the_fixed_values_again(tmp_path):
