@@ -445,10 +445,30 @@ def test_the_pages_three_commands_do_what_it_says(tmp_path):
     assert done[1].stdout.startswith("pp_contact.fmu: 14 of the full FMU's 365 variables")
     assert "the 14 variables of `pp_contact.fmu`" in PAGE
     assert (tmp_path / "pp_h20.fmu").is_file() and (tmp_path / "pp_drop.ssp").is_file()
-    python = page_blocks("python")[0]
-    run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.strip() == python.split("# ")[-1].strip()
+    for python in page_blocks("python")[:2]:  # fmpy, then libcosim
+        run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True,
+                             timeout=300)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.strip() == python.split("# ")[-1].strip()
+
+
+def test_an_ssp_of_an_exported_contact_runs_in_libcosim_and_fmpy_as_the_shipped_one(tmp_path):
+    """drop_test.ssp with its contact exported at the values its bindings
+    set: run_libcosim reports the scene, law and coupling the exported
+    contact fixes (it exposes none of them); libcosim and fmpy give the
+    shipped SSP's figures (the full FMU's) to the last bit, at two steps."""
+    from fraccontact.ssp import run_fmpy, run_libcosim, with_exported
+    ssp = FMU2.parent / "drop_test.ssp"
+    contact = tmp_path / "contact.fmu"
+    out = fraccontact.export(contact, scene="driven", coupling="jacobi", values=dict(law=2))
+    assert not {"scene", "law", "coupling"} & set(out["variables"])
+    mine = with_exported(ssp, {"contact": contact}, tmp_path / "exported.ssp")
+    for H in (1e-4, 1e-5):
+        a, b = run_libcosim(mine, H), run_libcosim(ssp, H)
+        assert a["applied"] == b["applied"] == {"scene": 2, "law": 2, "coupling": 2}
+        assert a == b and a["F_peak"] > 0
+        a, b = run_fmpy(mine, H), run_fmpy(ssp, H)
+        assert a.pop("rows").tobytes() == b.pop("rows").tobytes() and a == b
 
 
 def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tmp_path):
@@ -460,7 +480,7 @@ def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tm
     from fraccontact.scenes import systems
     from fraccontact.ssp import bound_parameters
     shipped = FMU2.parent / "headform.ssp"
-    block = page_blocks("python")[1].replace('"build/', f'"{FMU2.parent}/')
+    block = page_blocks("python")[2].replace('"build/', f'"{FMU2.parent}/')
     done = subprocess.run([sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     mine = tmp_path / "headform_exported.ssp"
