@@ -45,6 +45,17 @@ CONFIGURATIONS = {
 }
 
 
+# Model Exchange: (fmi, scene, bodies, values). The values differ from the defaults, as above.
+MODEL_EXCHANGE = {
+    "fmi2-me-drop-dashpot": (2, "drop", 1, dict(law="hertz", k=3.1e8, c=5200.0, v=0.7)),
+    "fmi3-me-drop-two-bodies-springpot-gravity": (3, "drop", 2, dict(law="hertz", damper="springpot",
+                                                                     c_alpha=2.5e5, damper_order=0.6, m2=1.5,
+                                                                     v2=-0.1, g=9.81)),
+    "fmi2-me-driven-springpot": (2, "driven", 1, dict(law="hertz", damper="springpot", v=0.4, m=0.0)),
+    "fmi3-me-driven-two-bodies-dashpot": (3, "driven", 2, dict(law="hertz", c=4000.0, v=0.5, v2=-0.2, m=0.0)),
+}
+
+
 def full_names(fmu):
     return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
 
@@ -106,9 +117,19 @@ def test_a_kept_variable_stays_tunable_and_starts_at_its_given_value(tmp_path, n
         assert mine["x2"].tobytes() == theirs["x2"].tobytes()
 
 
-@pytest.mark.parametrize("name", CONFIGURATIONS)
+def exported_any(tmp_path, name):
+    """A co-simulation configuration's export, or a Model Exchange one's; and its FMI version."""
+    if name in CONFIGURATIONS:
+        return (*exported(tmp_path, name), CONFIGURATIONS[name][0])
+    fmi, scene, bodies, values = MODEL_EXCHANGE[name]
+    path = tmp_path / f"{name}.fmu"
+    out = fraccontact.export(path, scene=scene, bodies=bodies, coupling="model-exchange", fmi=fmi, values=values)
+    return path, out, fmi
+
+
+@pytest.mark.parametrize("name", [*CONFIGURATIONS, *MODEL_EXCHANGE])
 def test_exported_fmus_pass_fmpys_validation_and_the_toolbox_checker(tmp_path, name):
-    path, out = exported(tmp_path, name)
+    path, out, _ = exported_any(tmp_path, name)
     assert validate_fmu(str(path)) == []
     done = subprocess.run([str(pathlib.Path(sys.executable).parent / "fmutool"), "-input", str(path), "-check"],
                           capture_output=True, text=True)
@@ -117,13 +138,12 @@ def test_exported_fmus_pass_fmpys_validation_and_the_toolbox_checker(tmp_path, n
     assert "No semantic error" in log and "seems to be compliant" in log and "ERROR" not in log, log
 
 
-@pytest.mark.parametrize("name", CONFIGURATIONS)
+@pytest.mark.parametrize("name", [*CONFIGURATIONS, *MODEL_EXCHANGE])
 def test_the_model_structure_is_renumbered_consistently(tmp_path, name):
     """FMI 2.0: every Unknown's index and dependency is the 1-based position
     of the same variable in the exported ModelVariables as in the full one;
     FMI 3.0: every reference is a value reference of an exposed variable."""
-    path, out = exported(tmp_path, name)
-    fmi = CONFIGURATIONS[name][0]
+    path, out, fmi = exported_any(tmp_path, name)
     full = ET.fromstring(zipfile.ZipFile(FMU2 if fmi == 2 else FMU3).read("modelDescription.xml"))
     mine = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
 
@@ -144,6 +164,44 @@ def test_the_model_structure_is_renumbered_consistently(tmp_path, name):
     exposed = set(out["variables"])
     expected = {key: deps & exposed for key, deps in unknowns(full).items() if key[1] in exposed}
     assert unknowns(mine) == expected
+
+
+def run_model_exchange(fmu, outputs, **start):
+    return simulate_fmu(str(fmu), start_values=start, stop_time=STOP, output_interval=INTERVAL, output=outputs,
+                        fmi_type="ModelExchange")
+
+
+@pytest.mark.parametrize("name", MODEL_EXCHANGE)
+def test_a_model_exchange_export_gives_the_full_fmus_model_exchange_results_to_the_last_bit(tmp_path, name):
+    """export --coupling model-exchange: an FMU of Model Exchange alone,
+    with every state, derivative and event indicator of the full FMU and
+    none of the co-simulation's averages; fmpy's CVode run of it has, at
+    every output point, the bits of the full FMU's Model Exchange run at the
+    same values; it passes fmpy's validation; the full FMU at its defaults'
+    law 2 differs (the file is read)."""
+    fmi, scene, bodies, values = MODEL_EXCHANGE[name]
+    path, out, _ = exported_any(tmp_path, name)
+    md = read_model_description(str(path))
+    assert md.modelExchange is not None and md.coSimulation is None
+    full = FMU2 if fmi == 2 else FMU3
+    full_md = read_model_description(str(full))
+    assert len(md.derivatives) == len(full_md.derivatives) > 4
+    assert [d.variable.name for d in md.derivatives] == [d.variable.name for d in full_md.derivatives]
+    assert [d.variable.derivative.name for d in md.derivatives] == \
+        [d.variable.derivative.name for d in full_md.derivatives]
+    assert md.numberOfEventIndicators == full_md.numberOfEventIndicators == 2
+    assert not {"F_avg", "F_avg_next", "a", "a2", "coupling"} & set(out["variables"])
+    assert "\nomit F_avg\n" in out["fixed"] and "\nomit F_avg_next\n" in out["fixed"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    words = fraccontact.model.WORDS
+    given = dict({n: words[n][x] if isinstance(x, str) else x for n, x in values.items()},
+                 scene=words["scene"][scene])
+    mine, theirs = run_model_exchange(path, outputs), run_model_exchange(full, outputs, **given)
+    for column in ["time"] + outputs:
+        assert mine[column].tobytes() == theirs[column].tobytes(), column
+    assert mine["F_peak"][-1] > 0
+    assert run_model_exchange(full, outputs, law=2)["F_peak"][-1] != mine["F_peak"][-1]
+    assert validate_fmu(str(path)) == []
 
 
 def test_a_one_body_dashpot_from_a_fit_exposes_its_inputs_outputs_and_kept_parameters(tmp_path):
@@ -378,7 +436,10 @@ def test_a_reset_sets_the_fixed_values_again(tmp_path):
     (["--c", "-1"], "c = -1 is invalid: the dashpot constant must be positive"),
     (["--law", "cubic"], "law = 'cubic' is invalid: it must be a whole number that fits a C int or one of g1, "
                          "hertz, g1x"),
-    (["--coupling", "model-exchange"], "coupling = model-exchange: the shipped FMUs are co-simulation FMUs"),
+    # Model Exchange's rules, as the FMU words them at initialization
+    (["--coupling", "model-exchange"], "law = 1 is invalid: Model Exchange takes the closed-form force, law = 2"),
+    (["--coupling", "model-exchange", "--law", "hertz", "--damper", "2", "--memory", "1", "--fmi", "3"],
+     "memory = 1 is invalid: Model Exchange takes the springpot's compressed memory"),
     (["--keep", "F"], "keep = 'F' is invalid: it must name a parameter or input of the FMU"),
     (["--m2", "2"], "m2 = 2.0 is invalid with bodies = 1"),
     # the FMU's own rules, met at the instantiation export tries
@@ -407,16 +468,27 @@ def test_the_pages_counts_are_what_export_writes(tmp_path):
     """The table of exposed variables per scene and bodies, for both FMI
     versions and both couplings, and the full FMUs' counts the page names."""
     table = PAGE.split("<!-- export-counts:begin -->")[1].split("<!-- export-counts:end -->")[0]
-    rows = re.findall(r"^\| (drop|driven) \| (\d) \| (\d+) \| (\d+) \|$", table, re.M)
+    rows = re.findall(r"^\| (drop|driven) \| (\d) \| (\d+) \| (\d+) \| (\d+) \| (\d+) \|$", table, re.M)
     assert len(rows) == 4
     for scene, bodies, *counts in rows:
-        for fmi, count in zip((2, 3), counts):
-            for coupling in COUPLINGS:
+        for (fmi, couplings), count in zip(((2, COUPLINGS), (3, COUPLINGS), (2, ["model-exchange"]),
+                                            (3, ["model-exchange"])), counts):
+            for coupling in couplings:
+                values = dict(law="hertz") if coupling == "model-exchange" else {}
                 out = fraccontact.export(tmp_path / "x.fmu", scene=scene, bodies=int(bodies), coupling=coupling,
-                                         fmi=fmi)
+                                         fmi=fmi, values=values)
                 assert len(out["variables"]) == int(count), (scene, bodies, fmi, coupling)
     assert "against the full FMU's 365 variables (FMI 2.0) and 366 (FMI 3.0" in " ".join(PAGE.split())
     assert (len(full_names(FMU2)), len(full_names(FMU3))) == (365, 366)
+
+
+def test_the_pages_model_exchange_command_does_what_it_says(tmp_path):
+    command, count = re.search(r"For the h20 drop test: `(fraccontact export [^`]+)` \(it prints the (\d+) "
+                               r"variables\)", " ".join(PAGE.split())).groups()
+    done = subprocess.run([sys.executable, "-m", *command.split()], cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"pp_me.fmu: {count} of the full FMU's 365 variables")
+    assert read_model_description(str(tmp_path / "pp_me.fmu")).modelExchange is not None
 
 
 def test_the_pages_file_limit_is_the_glues():
