@@ -491,6 +491,24 @@ def test_the_pages_model_exchange_command_does_what_it_says(tmp_path):
     assert read_model_description(str(tmp_path / "pp_me.fmu")).modelExchange is not None
 
 
+def test_the_pages_specialized_build_section_follows_from_its_figures():
+    """The report's figures on the page give its ratio and its decision by
+    docs/benchmarks.md's rule, and its edits still apply to the sources (so
+    that scripts/report specialized measures it again)."""
+    sys.path.insert(0, str(ROOT))
+    from reports import specialized
+    text = " ".join(PAGE.split(specialized.BEGIN)[1].split(specialized.END)[0].split())
+    mine, general, ratio = re.search(r"executes ([\d,]+) instructions per run .*? against the general build's "
+                                     r"([\d,]+): ratio ([\d.]+),", text).groups()
+    mine, general = (float(x.replace(",", "")) for x in (mine, general))
+    assert f"{mine / general:.3f}" == ratio
+    assert ("keep the general binary" in text) == (mine / general >= 1 - specialized.BEYOND_NOISE)
+    assert "off 1 by more than twice the larger spread of its row and by over 3 %" in \
+        " ".join((ROOT / "docs" / "benchmarks.md").read_text().split())
+    for name, old, new in specialized.SPECIALIZED:
+        assert (ROOT / name).read_text().count(old) == 1, (name, old)
+
+
 def test_the_pages_file_limit_is_the_glues():
     header = (ROOT / "fmu_src" / "glue" / "fixed_values.h").read_text()
     limit = re.search(r"#define FV_MAX_BYTES (\d+)", header).group(1)
