@@ -1,6 +1,6 @@
-"""Issue 38's item 5 measured: the FMU compiled for one configuration, the
-law and the damper known at compile time, against the general build, side
-by side in callgrind's instructions, and the decision they support, written
+"""Whether a model compiled for one configuration pays: the FMU with the law
+and the damper known at compile time against the general build, side by
+side in callgrind's instructions, and the decision they support, written
 into docs/export.md (between its markers <!-- specialized:begin/end -->).
 
 The configuration is the h20 drop test's, the default experiment of
