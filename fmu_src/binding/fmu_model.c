@@ -1037,7 +1037,8 @@ static fm_status refuse_state(fmu_model *fm, fmu_model *trial, const char *fmt, 
     char why[512];
     va_list args;
     contact_release_modes(&trial->model);
-    release_prediction(trial);
+    if (trial->next)
+        contact_release_modes(&trial->next->model);
     va_start(args, fmt);
     vsnprintf(why, sizeof why, fmt, args);
     va_end(args);
@@ -1047,6 +1048,7 @@ static fm_status refuse_state(fmu_model *fm, fmu_model *trial, const char *fmt, 
 fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 {
     fmu_model trial = *fm;
+    prediction fresh; /* trial's, its modes in a block of its own: fm's storage takes it once the state is read */
     const unsigned char *memory = NULL;
     const char *problem;
     char why[256];
@@ -1072,8 +1074,11 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     /* the compressed memory's modes in blocks of trial's own, fm's kept
      * until the state is read */
     memset(&trial.model.modes, 0, sizeof trial.model.modes);
-    trial.next = NULL;
-    if (contact_configure(&trial.model, &trial.params) != 0 || prediction_room(&trial) != 0)
+    memset(&fresh, 0, sizeof fresh);
+    trial.next = fm->no_prediction ? NULL : &fresh;
+    if (contact_configure(&trial.model, &trial.params) != 0
+        || (trial.next && !fm->next && !(fm->next = calloc(1, sizeof *fm->next)))
+        || (trial.next && contact_copy_room(&fresh.model, &trial.model) != 0))
         return refuse_state(fm, &trial, "out of memory for the FMU state's springpot modes (memory = 2)");
     trial.model.max_steps = MAX_STEPS;
     if (nonfinite_output(&trial))
@@ -1089,8 +1094,12 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     for (i = 0; i < count; i++)
         contact_memory_set(&trial.model, i, serial_get_double(memory + 8 * i));
     contact_release_modes(&fm->model);
-    release_prediction(fm);
-    *fm = trial; /* its prediction empty: a memo of the next step, which the next step computes again, to the bit */
+    if (trial.next) { /* empty: a memo of the next step, which the next step computes again, to the bit */
+        contact_release_modes(&fm->next->model);
+        *fm->next = fresh;
+        trial.next = fm->next;
+    }
+    *fm = trial;
     return FM_OK;
 }
 
