@@ -143,11 +143,12 @@ def memory_sentence(m):
     sizes = "; ".join(f"{configuration_name(c)}: {c['instance_bytes']:,} B, state {c['state_bytes']:,} B"
                       for c in m["configurations"])
     return ("- **Memory per configuration** (`fraccontact-soak memory`: the heap bytes an initialized FMU instance "
-            "holds, malloc's own overhead included, and its serialized FMU state's size): " + sizes + ". A dashpot "
+            "holds with 1,000 alive, malloc's own overhead included, and its serialized FMU state's size): " + sizes + ". A dashpot "
             "instance holds no springpot memory: at most 2 KiB. The compressed memory's M modes take, in the model "
             "and again in its prediction of the next step, one block of 12 arrays of M doubles rounded up to whole "
             "8 lanes, allocated at initialization (never in a step); the FMU state 8 B a mode. The full G1 "
-            "history's buffer grows as the run steps (16 B a step; 8 B a step in the state).")
+            "history's buffer grows as the run steps (16 B a step; 8 B a step in the state). An exported FMU "
+            "that does not offer F_avg_next keeps no prediction (docs/export.md).")
 
 
 def write(path, s, v, f, hostile_summary):

@@ -10,7 +10,9 @@
  *   fraccontact-soak fmu-seconds S    S simulated seconds of bouncing, then resting on
  *                                     the specimen, through the FMU (dt_max = 1e-6 s)
  *   fraccontact-soak memory           the heap bytes an initialized instance holds and
- *                                     its serialized FMU state's, per configuration */
+ *                                     its serialized FMU state's, per configuration
+ *   fraccontact-soak memory URI GUID  the same for an exported FMU: its resources folder's
+ *                                     file: URI and its GUID (docs/export.md) */
 #define _POSIX_C_SOURCE 200809L
 
 #include <inttypes.h>
@@ -233,32 +235,63 @@ static size_t heap_bytes(void)
     return mallinfo2().uordblks;
 }
 
+/* Instances alive at once for a heap measure: malloc keeps a few freed
+ * blocks of each size cached, which count as in use; spread over this many
+ * instances they count for less than a byte each. */
+#define MEASURED 1000
+
+/* An instance of the FMU of `guid` (its resources folder's URI; "" for
+ * none), given `ints` for damper and memory and `reals` for
+ * memory_tolerance unless NULL, initialized (a warning of a value without
+ * effect allowed); NULL after a message. */
+static fmi2Component started(const char *guid, const char *resources, const fmi2Integer *ints,
+                             const fmi2Real *reals)
+{
+    const fmi2ValueReference vr_int[] = {VR_damper, VR_memory}, vr_real[] = {VR_memory_tolerance};
+    fmi2Component x = fmi2Instantiate("soak", fmi2CoSimulation, guid, resources, &callbacks, fmi2False, fmi2False);
+    if (!x || (ints && (fmi2SetInteger(x, vr_int, 2, ints) != fmi2OK || fmi2SetReal(x, vr_real, 1, reals) != fmi2OK))
+        || fmi2EnterInitializationMode(x) != fmi2OK || fmi2ExitInitializationMode(x) > fmi2Warning) {
+        fprintf(stderr, "fraccontact-soak: an instance did not start\n");
+        return NULL;
+    }
+    return x;
+}
+
+/* The heap bytes an initialized instance holds (started's arguments), with
+ * MEASURED alive, and its serialized FMU state's size: 0, or 1 after a message. */
+static int instance_memory(const char *guid, const char *resources, const fmi2Integer *ints, const fmi2Real *reals,
+                           size_t *held, size_t *state_bytes)
+{
+    static fmi2Component x[MEASURED];
+    fmi2FMUstate state = NULL;
+    size_t before = heap_bytes(), i, n;
+    for (n = 0; n < MEASURED && (x[n] = started(guid, resources, ints, reals)); n++)
+        ;
+    *held = (heap_bytes() - before + MEASURED / 2) / MEASURED;
+    if (n == MEASURED
+        && (fmi2GetFMUstate(x[0], &state) != fmi2OK || fmi2SerializedFMUstateSize(x[0], state, state_bytes) != fmi2OK))
+        fprintf(stderr, "fraccontact-soak: no FMU state\n");
+    fmi2FreeFMUstate(x[0], &state);
+    for (i = 0; i < n; i++)
+        fmi2FreeInstance(x[i]);
+    return n < MEASURED || !*state_bytes;
+}
+
 /* One configuration's instance, initialized: the heap bytes it holds and
  * its serialized FMU state's size, printed with the compressed memory's
  * mode count (the model's kernel for the same parameters). */
 static int configuration_memory(int damper, int memory, double memory_tolerance, const char *comma)
 {
-    fmi2ValueReference vr_int[] = {VR_damper, VR_memory}, vr_real[] = {VR_memory_tolerance};
     fmi2Integer ints[] = {damper, memory};
     fmi2Real reals[] = {memory_tolerance};
     contact_params p;
     contact_model cm;
-    fmi2FMUstate state = NULL;
-    size_t before = heap_bytes(), held, state_bytes = 0, modes;
+    size_t held, state_bytes = 0, modes;
     double v0, m;
-    fmi2Component x = fmi2Instantiate("soak", fmi2CoSimulation, FMU_GUID, "", &callbacks, fmi2False, fmi2False);
-    if (!x || fmi2SetInteger(x, vr_int, 2, ints) != fmi2OK || fmi2SetReal(x, vr_real, 1, reals) != fmi2OK
-        || fmi2EnterInitializationMode(x) != fmi2OK || fmi2ExitInitializationMode(x) != fmi2OK) {
+    if (instance_memory(FMU_GUID, "", ints, reals, &held, &state_bytes) != 0) {
         fprintf(stderr, "fraccontact-soak: an instance (damper = %d, memory = %d) did not start\n", damper, memory);
         return 1;
     }
-    held = heap_bytes() - before;
-    if (fmi2GetFMUstate(x, &state) != fmi2OK || fmi2SerializedFMUstateSize(x, state, &state_bytes) != fmi2OK) {
-        fprintf(stderr, "fraccontact-soak: no FMU state (damper = %d, memory = %d)\n", damper, memory);
-        return 1;
-    }
-    fmi2FreeFMUstate(x, &state);
-    fmi2FreeInstance(x);
     contact_default_params(&p);
     p.damper = damper;
     p.memory = memory;
@@ -270,6 +303,21 @@ static int configuration_memory(int damper, int memory, double memory_tolerance,
     contact_release(&cm);
     printf("{\"damper\": %d, \"memory\": %d, \"memory_tolerance\": %g, \"modes\": %zu, \"instance_bytes\": %zu, "
            "\"state_bytes\": %zu}%s", damper, memory, memory_tolerance, modes, held, state_bytes, comma);
+    return 0;
+}
+
+/* An exported FMU's instance at its fixed values, initialized: the heap
+ * bytes it holds and its serialized FMU state's size. */
+static int exported_memory(const char *resources, const char *guid)
+{
+    size_t held, state_bytes = 0;
+    fmi2Component first = started(guid, resources, NULL, NULL);
+    if (!first)
+        return 1;
+    fmi2FreeInstance(first); /* the first instance's one-time allocations apart */
+    if (instance_memory(guid, resources, NULL, NULL, &held, &state_bytes) != 0)
+        return 1;
+    printf("{\"instance_bytes\": %zu, \"state_bytes\": %zu}\n", held, state_bytes);
     return 0;
 }
 
@@ -293,6 +341,8 @@ int main(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "memory") == 0)
         return memory_per_configuration();
+    if (argc == 4 && strcmp(argv[1], "memory") == 0)
+        return exported_memory(argv[2], argv[3]);
     if (argc == 3 && strcmp(argv[1], "instances") == 0)
         return instances(atol(argv[2]));
     if (argc == 3 && strcmp(argv[1], "threads") == 0)
@@ -301,6 +351,6 @@ int main(int argc, char **argv)
         return steps(atof(argv[2]));
     if (argc == 3 && strcmp(argv[1], "fmu-seconds") == 0)
         return fmu_seconds(atof(argv[2]));
-    fprintf(stderr, "usage: fraccontact-soak instances N | threads T | steps S | fmu-seconds S | memory\n");
+    fprintf(stderr, "usage: fraccontact-soak instances N | threads T | steps S | fmu-seconds S | memory [URI GUID]\n");
     return 2;
 }

@@ -45,6 +45,17 @@ CONFIGURATIONS = {
 }
 
 
+# Model Exchange: (fmi, scene, bodies, values). The values differ from the defaults, as above.
+MODEL_EXCHANGE = {
+    "fmi2-me-drop-dashpot": (2, "drop", 1, dict(law="hertz", k=3.1e8, c=5200.0, v=0.7)),
+    "fmi3-me-drop-two-bodies-springpot-gravity": (3, "drop", 2, dict(law="hertz", damper="springpot",
+                                                                     c_alpha=2.5e5, damper_order=0.6, m2=1.5,
+                                                                     v2=-0.1, g=9.81)),
+    "fmi2-me-driven-springpot": (2, "driven", 1, dict(law="hertz", damper="springpot", v=0.4, m=0.0)),
+    "fmi3-me-driven-two-bodies-dashpot": (3, "driven", 2, dict(law="hertz", c=4000.0, v=0.5, v2=-0.2, m=0.0)),
+}
+
+
 def full_names(fmu):
     return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
 
@@ -106,9 +117,19 @@ def test_a_kept_variable_stays_tunable_and_starts_at_its_given_value(tmp_path, n
         assert mine["x2"].tobytes() == theirs["x2"].tobytes()
 
 
-@pytest.mark.parametrize("name", CONFIGURATIONS)
+def exported_any(tmp_path, name):
+    """A co-simulation configuration's export, or a Model Exchange one's; and its FMI version."""
+    if name in CONFIGURATIONS:
+        return (*exported(tmp_path, name), CONFIGURATIONS[name][0])
+    fmi, scene, bodies, values = MODEL_EXCHANGE[name]
+    path = tmp_path / f"{name}.fmu"
+    out = fraccontact.export(path, scene=scene, bodies=bodies, coupling="model-exchange", fmi=fmi, values=values)
+    return path, out, fmi
+
+
+@pytest.mark.parametrize("name", [*CONFIGURATIONS, *MODEL_EXCHANGE])
 def test_exported_fmus_pass_fmpys_validation_and_the_toolbox_checker(tmp_path, name):
-    path, out = exported(tmp_path, name)
+    path, out, _ = exported_any(tmp_path, name)
     assert validate_fmu(str(path)) == []
     done = subprocess.run([str(pathlib.Path(sys.executable).parent / "fmutool"), "-input", str(path), "-check"],
                           capture_output=True, text=True)
@@ -117,13 +138,12 @@ def test_exported_fmus_pass_fmpys_validation_and_the_toolbox_checker(tmp_path, n
     assert "No semantic error" in log and "seems to be compliant" in log and "ERROR" not in log, log
 
 
-@pytest.mark.parametrize("name", CONFIGURATIONS)
+@pytest.mark.parametrize("name", [*CONFIGURATIONS, *MODEL_EXCHANGE])
 def test_the_model_structure_is_renumbered_consistently(tmp_path, name):
     """FMI 2.0: every Unknown's index and dependency is the 1-based position
     of the same variable in the exported ModelVariables as in the full one;
     FMI 3.0: every reference is a value reference of an exposed variable."""
-    path, out = exported(tmp_path, name)
-    fmi = CONFIGURATIONS[name][0]
+    path, out, fmi = exported_any(tmp_path, name)
     full = ET.fromstring(zipfile.ZipFile(FMU2 if fmi == 2 else FMU3).read("modelDescription.xml"))
     mine = ET.fromstring(zipfile.ZipFile(path).read("modelDescription.xml"))
 
@@ -144,6 +164,44 @@ def test_the_model_structure_is_renumbered_consistently(tmp_path, name):
     exposed = set(out["variables"])
     expected = {key: deps & exposed for key, deps in unknowns(full).items() if key[1] in exposed}
     assert unknowns(mine) == expected
+
+
+def run_model_exchange(fmu, outputs, **start):
+    return simulate_fmu(str(fmu), start_values=start, stop_time=STOP, output_interval=INTERVAL, output=outputs,
+                        fmi_type="ModelExchange")
+
+
+@pytest.mark.parametrize("name", MODEL_EXCHANGE)
+def test_a_model_exchange_export_gives_the_full_fmus_model_exchange_results_to_the_last_bit(tmp_path, name):
+    """export --coupling model-exchange: an FMU of Model Exchange alone,
+    with every state, derivative and event indicator of the full FMU and
+    none of the co-simulation's averages; fmpy's CVode run of it has, at
+    every output point, the bits of the full FMU's Model Exchange run at the
+    same values; it passes fmpy's validation; the full FMU at its defaults'
+    law 2 differs (the file is read)."""
+    fmi, scene, bodies, values = MODEL_EXCHANGE[name]
+    path, out, _ = exported_any(tmp_path, name)
+    md = read_model_description(str(path))
+    assert md.modelExchange is not None and md.coSimulation is None
+    full = FMU2 if fmi == 2 else FMU3
+    full_md = read_model_description(str(full))
+    assert len(md.derivatives) == len(full_md.derivatives) > 4
+    assert [d.variable.name for d in md.derivatives] == [d.variable.name for d in full_md.derivatives]
+    assert [d.variable.derivative.name for d in md.derivatives] == \
+        [d.variable.derivative.name for d in full_md.derivatives]
+    assert md.numberOfEventIndicators == full_md.numberOfEventIndicators == 2
+    assert not {"F_avg", "F_avg_next", "a", "a2", "coupling"} & set(out["variables"])
+    assert "\nomit F_avg\n" in out["fixed"] and "\nomit F_avg_next\n" in out["fixed"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    words = fraccontact.model.WORDS
+    given = dict({n: words[n][x] if isinstance(x, str) else x for n, x in values.items()},
+                 scene=words["scene"][scene])
+    mine, theirs = run_model_exchange(path, outputs), run_model_exchange(full, outputs, **given)
+    for column in ["time"] + outputs:
+        assert mine[column].tobytes() == theirs[column].tobytes(), column
+    assert mine["F_peak"][-1] > 0
+    assert run_model_exchange(full, outputs, law=2)["F_peak"][-1] != mine["F_peak"][-1]
+    assert validate_fmu(str(path)) == []
 
 
 def test_a_one_body_dashpot_from_a_fit_exposes_its_inputs_outputs_and_kept_parameters(tmp_path):
@@ -191,6 +249,9 @@ HOSTILE = [
     ("end\nc 1\n", 'line 2: text after the line "end"'),
     ("guid {a}\nguid {b}\nend\n", "line 2: guid is already set on line 1; it takes one line"),
     ("c 1\0\nend\n", "holds a NUL byte"),
+    ("omit c\nend\n", "line 1: omit c: an input or a parameter, which the FMU has to offer"),
+    ("omit cc\nend\n", "line 1: omit cc: no variable of this FMU has that name"),
+    ("omit F\n\nomit F\nend\n", "line 3: omit F: already on line 1"),
     ("#" * 20000 + "\nend\n", "is larger than 16384 bytes"),
 ]
 
@@ -273,6 +334,88 @@ def test_an_exported_fmu_has_its_own_guid_which_its_binary_takes_from_its_file(t
                                              f"resources/fixed_values.txt, which this FMU has not)")
 
 
+SOAK = os.environ.get("FRACCONTACT_SOAK", str(ROOT / "build" / "fraccontact-soak"))
+
+
+def soak_memory(*args):
+    done = subprocess.run([SOAK, "memory", *args], capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+@pytest.mark.skipif(os.environ.get("FRACCONTACT_SANITIZED") == "1",
+                    reason="AddressSanitizer's allocator keeps its own account of the heap")
+def test_a_gauss_seidel_export_keeps_no_prediction_and_holds_what_the_page_says(tmp_path):
+    """A one-body dashpot exported for the drop test (Gauss-Seidel) omits
+    F_avg_next: its instance holds at most 2 KiB, less than the full FMU's
+    by at least the contact model it keeps no second copy of, the page's
+    figures as fraccontact-soak measures them; a Jacobi export omits F_avg
+    and keeps its prediction (no smaller than the full FMU's)."""
+    path = tmp_path / "gs.fmu"
+    out = fraccontact.export(path)  # the h20 drop test's values
+    assert "\nomit F_avg_next\n" in out["fixed"] and "\nomit F_avg\n" not in out["fixed"]
+    folder = tmp_path / "gs"
+    extract(str(path), unzipdir=str(folder))
+    guid = read_model_description(str(path)).guid
+    mine = soak_memory((folder / "resources").as_uri(), guid)["instance_bytes"]
+    full = soak_memory()
+    dashpot = full["configurations"][0]
+    assert (dashpot["damper"], dashpot["memory"]) == (1, 2) and mine <= 2048
+    # the same file without its omission: the prediction back, a contact model and its few scalars, in a
+    # block of its own (malloc's header), less the list entry the omission took
+    (folder / FIXED_VALUES).write_text(out["fixed"].replace("\nomit F_avg_next\n", "\n"))
+    predicting = soak_memory((folder / "resources").as_uri(), guid)["instance_bytes"]
+    assert full["bytes_contact_model"] <= predicting - mine <= full["bytes_contact_model"] + 64
+    said = re.search(r"<!-- export-memory -->([\d,]+) B per instance, against the full FMU's ([\d,]+) "
+                     r"B<!-- /export-memory -->", PAGE)
+    assert said and [int(x.replace(",", "")) for x in said.groups()] == [mine, dashpot["instance_bytes"]]
+    jacobi = tmp_path / "jacobi.fmu"
+    out = fraccontact.export(jacobi, coupling="jacobi")
+    assert "\nomit F_avg\n" in out["fixed"] and "\nomit F_avg_next\n" not in out["fixed"]
+    folder = tmp_path / "jacobi"
+    extract(str(jacobi), unzipdir=str(folder))
+    held = soak_memory((folder / "resources").as_uri(), read_model_description(str(jacobi)).guid)
+    assert held["instance_bytes"] >= dashpot["instance_bytes"]
+
+
+def test_an_instance_without_f_avg_next_refuses_it_and_the_jacobi_coupling(tmp_path):
+    """A file that omits F_avg_next: reading it is an error naming it, before
+    and after a reset (the omission is set again); an FMU state set again
+    steps as before; coupling = 2 is refused
+    when set and, from the file, at initialization; the full FMU reads it."""
+    md = read_model_description(str(FMU2))
+    folder = unpacked_with(tmp_path, FMU2, "omit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=True, instance_name="lean")
+    vr = next(v.valueReference for v in md.modelVariables if v.name == "F_avg_next")
+    # an FMU state taken in the impact and set again: the same steps from it, to the bit
+    for _ in range(30):
+        s.step(INTERVAL)
+    state, t = s.fmu.getFMUstate(), s.t
+    ahead = [s.step(INTERVAL) or s.get("F_avg") for _ in range(100)]
+    s.fmu.setFMUstate(state)
+    s.t = t
+    assert [s.step(INTERVAL) or s.get("F_avg") for _ in range(100)] == ahead and max(ahead) > 0
+    for reset in (False, True):
+        if reset:
+            s.fmu.reset()
+            s.enter()
+        with pytest.raises(Exception):
+            s.fmu.getReal([vr])
+        assert fraccontact.fmu._RECENT[-1][2].startswith(f"F_avg_next (value reference {vr}): this exported FMU "
+                                                         "does not offer it"), fraccontact.fmu._RECENT[-1]
+    folder = unpacked_with(tmp_path, FMU2, "end\n")
+    assert len(Slave(md, str(folder), start=True, instance_name="full").fmu.getReal([vr])) == 1
+    folder = unpacked_with(tmp_path, FMU2, "omit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=False, instance_name="set")
+    with pytest.raises(Exception):
+        s.set(coupling=2)
+    assert "coupling = 2 is invalid: this FMU does not offer F_avg_next" in fraccontact.fmu._RECENT[-1][2]
+    folder = unpacked_with(tmp_path, FMU2, "coupling 2\nomit F_avg_next\nend\n")
+    s = Slave(md, str(folder), start=False, instance_name="file")
+    with pytest.raises(Exception):
+        s.start()
+    assert "coupling = 2 is invalid: this FMU does not offer F_avg_next" in fraccontact.fmu._RECENT[-1][2]
+
+
 def test_a_reset_sets_the_fixed_values_again(tmp_path):
     """fmi2Reset and fmi3Reset: the instance as instantiated, its fixed
     values set again (read through the full FMU's references)."""
@@ -302,7 +445,10 @@ def test_a_reset_sets_the_fixed_values_again(tmp_path):
     (["--c", "-1"], "c = -1 is invalid: the dashpot constant must be positive"),
     (["--law", "cubic"], "law = 'cubic' is invalid: it must be a whole number that fits a C int or one of g1, "
                          "hertz, g1x"),
-    (["--coupling", "model-exchange"], "coupling = model-exchange: the shipped FMUs are co-simulation FMUs"),
+    # Model Exchange's rules, as the FMU words them at initialization
+    (["--coupling", "model-exchange"], "law = 1 is invalid: Model Exchange takes the closed-form force, law = 2"),
+    (["--coupling", "model-exchange", "--law", "hertz", "--damper", "2", "--memory", "1", "--fmi", "3"],
+     "memory = 1 is invalid: Model Exchange takes the springpot's compressed memory"),
     (["--keep", "F"], "keep = 'F' is invalid: it must name a parameter or input of the FMU"),
     (["--m2", "2"], "m2 = 2.0 is invalid with bodies = 1"),
     # the FMU's own rules, met at the instantiation export tries
@@ -331,16 +477,45 @@ def test_the_pages_counts_are_what_export_writes(tmp_path):
     """The table of exposed variables per scene and bodies, for both FMI
     versions and both couplings, and the full FMUs' counts the page names."""
     table = PAGE.split("<!-- export-counts:begin -->")[1].split("<!-- export-counts:end -->")[0]
-    rows = re.findall(r"^\| (drop|driven) \| (\d) \| (\d+) \| (\d+) \|$", table, re.M)
+    rows = re.findall(r"^\| (drop|driven) \| (\d) \| (\d+) \| (\d+) \| (\d+) \| (\d+) \|$", table, re.M)
     assert len(rows) == 4
     for scene, bodies, *counts in rows:
-        for fmi, count in zip((2, 3), counts):
-            for coupling in COUPLINGS:
+        for (fmi, couplings), count in zip(((2, COUPLINGS), (3, COUPLINGS), (2, ["model-exchange"]),
+                                            (3, ["model-exchange"])), counts):
+            for coupling in couplings:
+                values = dict(law="hertz") if coupling == "model-exchange" else {}
                 out = fraccontact.export(tmp_path / "x.fmu", scene=scene, bodies=int(bodies), coupling=coupling,
-                                         fmi=fmi)
+                                         fmi=fmi, values=values)
                 assert len(out["variables"]) == int(count), (scene, bodies, fmi, coupling)
     assert "against the full FMU's 365 variables (FMI 2.0) and 366 (FMI 3.0" in " ".join(PAGE.split())
     assert (len(full_names(FMU2)), len(full_names(FMU3))) == (365, 366)
+
+
+def test_the_pages_model_exchange_command_does_what_it_says(tmp_path):
+    command, count = re.search(r"For the h20 drop test: `(fraccontact export [^`]+)` \(it prints the (\d+) "
+                               r"variables\)", " ".join(PAGE.split())).groups()
+    done = subprocess.run([sys.executable, "-m", *command.split()], cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"pp_me.fmu: {count} of the full FMU's 365 variables")
+    assert read_model_description(str(tmp_path / "pp_me.fmu")).modelExchange is not None
+
+
+def test_the_pages_specialized_build_section_follows_from_its_figures():
+    """The report's figures on the page give its ratio and its decision by
+    docs/benchmarks.md's rule, and its edits still apply to the sources (so
+    that scripts/report specialized measures it again)."""
+    sys.path.insert(0, str(ROOT))
+    from reports import specialized
+    text = " ".join(PAGE.split(specialized.BEGIN)[1].split(specialized.END)[0].split())
+    mine, general, ratio = re.search(r"executes ([\d,]+) instructions per run .*? against the general build's "
+                                     r"([\d,]+): ratio ([\d.]+),", text).groups()
+    mine, general = (float(x.replace(",", "")) for x in (mine, general))
+    assert f"{mine / general:.3f}" == ratio
+    assert ("keep the general binary" in text) == (mine / general >= 1 - specialized.BEYOND_NOISE)
+    assert "off 1 by more than twice the larger spread of its row and by over 3 %" in \
+        " ".join((ROOT / "docs" / "benchmarks.md").read_text().split())
+    for name, old, new in specialized.SPECIALIZED:
+        assert (ROOT / name).read_text().count(old) == 1, (name, old)
 
 
 def test_the_pages_file_limit_is_the_glues():
@@ -369,10 +544,30 @@ def test_the_pages_three_commands_do_what_it_says(tmp_path):
     assert done[1].stdout.startswith("pp_contact.fmu: 14 of the full FMU's 365 variables")
     assert "the 14 variables of `pp_contact.fmu`" in PAGE
     assert (tmp_path / "pp_h20.fmu").is_file() and (tmp_path / "pp_drop.ssp").is_file()
-    python = page_blocks("python")[0]
-    run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.strip() == python.split("# ")[-1].strip()
+    for python in page_blocks("python")[:2]:  # fmpy, then libcosim
+        run = subprocess.run([sys.executable, "-c", python], cwd=tmp_path, capture_output=True, text=True,
+                             timeout=300)
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.strip() == python.split("# ")[-1].strip()
+
+
+def test_an_ssp_of_an_exported_contact_runs_in_libcosim_and_fmpy_as_the_shipped_one(tmp_path):
+    """drop_test.ssp with its contact exported at the values its bindings
+    set: run_libcosim reports the scene, law and coupling the exported
+    contact fixes (it exposes none of them); libcosim and fmpy give the
+    shipped SSP's figures (the full FMU's) to the last bit, at two steps."""
+    from fraccontact.ssp import run_fmpy, run_libcosim, with_exported
+    ssp = FMU2.parent / "drop_test.ssp"
+    contact = tmp_path / "contact.fmu"
+    out = fraccontact.export(contact, scene="driven", coupling="jacobi", values=dict(law=2))
+    assert not {"scene", "law", "coupling"} & set(out["variables"])
+    mine = with_exported(ssp, {"contact": contact}, tmp_path / "exported.ssp")
+    for H in (1e-4, 1e-5):
+        a, b = run_libcosim(mine, H), run_libcosim(ssp, H)
+        assert a["applied"] == b["applied"] == {"scene": 2, "law": 2, "coupling": 2}
+        assert a == b and a["F_peak"] > 0
+        a, b = run_fmpy(mine, H), run_fmpy(ssp, H)
+        assert a.pop("rows").tobytes() == b.pop("rows").tobytes() and a == b
 
 
 def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tmp_path):
@@ -384,7 +579,7 @@ def test_the_headform_ssp_of_exported_contacts_gives_the_shipped_ssps_figures(tm
     from fraccontact.scenes import systems
     from fraccontact.ssp import bound_parameters
     shipped = FMU2.parent / "headform.ssp"
-    block = page_blocks("python")[1].replace('"build/', f'"{FMU2.parent}/')
+    block = page_blocks("python")[2].replace('"build/', f'"{FMU2.parent}/')
     done = subprocess.run([sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     mine = tmp_path / "headform_exported.ssp"

@@ -141,6 +141,18 @@ def test_the_checker_finds_nothing_in_an_exported_fmu(tmp_path, scene):
 
 
 @with_fmucheck
+@pytest.mark.parametrize("options", [("--law", "hertz"),
+                                     ("--law", "hertz", "--bodies", "2", "--g", "9.81"),
+                                     ("--law", "hertz", "--scene", "driven", "--fmi", "2")])
+def test_the_checker_finds_nothing_in_a_model_exchange_export(tmp_path, options):
+    """export --coupling model-exchange (the dashpot: the checker's forward
+    Euler at its fixed step is unstable on the springpot's fastest modes):
+    through the impact, events included."""
+    fmu = exported(tmp_path / "exported.fmu", ("--coupling", "model-exchange", *options))
+    assert check(fmu, "me", tmp_path) == []
+
+
+@with_fmucheck
 def test_the_checker_finds_nothing_in_fmi_3_0_where_it_reads_it(tmp_path):
     """The checker's last version (FMI Library 2.0.3) stops at FMI 3.0's
     modelDescription.xml: the FMI 3.0 FMU is checked by fmusim below, fmpy

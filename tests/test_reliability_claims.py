@@ -64,7 +64,8 @@ def test_the_memory_per_configuration_is_what_an_instance_allocates():
     the instance two blocks of 12 arrays of the modes padded to whole lanes,
     so that it grows with the kernel's mode count."""
     sizes, = claim(r"\*\*Memory per configuration\*\* \(`fraccontact-soak memory`: the heap bytes an initialized "
-                   r"FMU instance holds, malloc's own overhead included, and its serialized FMU state's size\): "
+                   r"FMU instance holds with 1,000 alive, malloc's own overhead included, and its serialized FMU state's "
+                   r"size\): "
                    r"(.*?)\. A dashpot instance holds no springpot memory: at most 2 KiB\.")
     rows = re.findall(r"(dashpot|springpot, memory = 1 \(before its first step\)|springpot, memory = 2, "
                       r"memory_tolerance = (\S+) \(M = (\d+)\)): ([\d,]+) B, state ([\d,]+) B", sizes)

@@ -10,6 +10,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The model advanced by one more communication step from the end of the
@@ -19,9 +20,9 @@
  * is shared with the model, room for the step reserved first. */
 typedef struct {
     int valid;
+    int event;            /* an onset or a separation inside it */
     double H;             /* the step's length */
     double impulse;       /* the contact force's impulse over it */
-    int event;            /* an onset or a separation inside it */
     contact_model model;  /* the state at its end */
 } prediction;
 
@@ -65,8 +66,9 @@ struct fmu_model {
     double held_eps;
     int model_exchange;   /* serves a Model Exchange instance (fm_me_instantiated) */
     double me_speed, me_mass; /* Model Exchange: the approach speed and mass its nominal values are of */
+    int no_prediction;    /* the FMU does not offer F_avg_next (fm_leave_out): nothing predicts */
     contact_model model;
-    prediction next;
+    prediction *next;     /* allocated at the start where F_avg_next is offered, else NULL */
     fmu_reporter log;
 };
 
@@ -106,8 +108,12 @@ static const fmu_variables variables = {variable_list, sizeof variable_list / si
 #define report(fm, ...) fmu_say(&(fm)->log, __VA_ARGS__)
 
 /* 0 when the binding's own parameter is usable, else -1 and why. */
-static int check_coupling(int coupling, char *why, size_t len)
+static int check_coupling(const fmu_model *fm, int coupling, char *why, size_t len)
 {
+    if (coupling == COUPLING_JACOBI && fm->no_prediction)
+        return contact_reject(why, len, "coupling", coupling,
+                              "this FMU does not offer F_avg_next, which the master feeds with coupling = 2 "
+                              "(Jacobi): 1 = the master feeds F_avg after this step (Gauss-Seidel)");
     if (coupling == COUPLING_GAUSS_SEIDEL || coupling == COUPLING_JACOBI)
         return 0;
     return contact_reject(why, len, "coupling", coupling,
@@ -167,7 +173,7 @@ static fm_status set_parameter(fmu_model *fm, const fmu_variable *var, const voi
         memcpy(&coupling, value, size);
     else
         memcpy((char *)&params + (var->offset - offsetof(fmu_model, params)), value, size);
-    if (contact_check_params(&params, why, sizeof why) != 0 || check_coupling(coupling, why, sizeof why) != 0)
+    if (contact_check_params(&params, why, sizeof why) != 0 || check_coupling(fm, coupling, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     memcpy((char *)fm + var->offset, value, size);
     return FM_OK;
@@ -271,6 +277,10 @@ fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
     var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
     if (!var)
         return FM_ERROR;
+    if (vr == VR_F_avg_next && fm->no_prediction)
+        return report(fm, FM_ERROR, "logStatusError",
+                      "F_avg_next (value reference %u): this exported FMU does not offer it (its "
+                      "resources/fixed_values.txt: omit F_avg_next); the Gauss-Seidel coupling reads F_avg", vr);
     preview_start(fm);
     *value = var->causality == VAR_OUTPUT ? real_output(fm, vr) : *(const double *)((const char *)fm + var->offset);
     return FM_OK;
@@ -342,10 +352,43 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     return FM_OK;
 }
 
+void fm_leave_out(fmu_model *fm, unsigned vr)
+{
+    if (vr == VR_F_avg_next)
+        fm->no_prediction = 1; /* the prediction is what gives F_avg_next */
+}
+
+/* The prediction's storage where the FMU offers F_avg_next, with room for
+ * the model's modes: 0, or -1 when memory runs out. */
+static int prediction_room(fmu_model *fm)
+{
+    if (fm->no_prediction)
+        return 0;
+    if (!fm->next)
+        fm->next = calloc(1, sizeof *fm->next);
+    return fm->next ? contact_copy_room(&fm->next->model, &fm->model) : -1;
+}
+
+static void forget_prediction(fmu_model *fm)
+{
+    if (fm->next)
+        fm->next->valid = 0;
+}
+
+static void release_prediction(fmu_model *fm)
+{
+    if (!fm->next)
+        return;
+    contact_release_modes(&fm->next->model);
+    free(fm->next);
+    fm->next = NULL;
+}
+
 fm_status fm_start(fmu_model *fm, double t0, double t_stop)
 {
     char why[512];
     if (contact_check_params(&fm->params, why, sizeof why) != 0
+        || check_coupling(fm, fm->coupling, why, sizeof why) != 0
         || check_bodies(&fm->params, fm->params.scene, &fm->in, why, sizeof why) != 0
         || contact_check_resolution(&fm->params, approach(&fm->in), proxy_mass(&fm->in), why, sizeof why) != 0
         || (isfinite(t_stop)
@@ -354,7 +397,7 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
         return report(fm, FM_ERROR, "logStatusError", "%s", why);
     contact_release(&fm->model);
     if (contact_start(&fm->model, &fm->params, approach(&fm->in), proxy_mass(&fm->in)) != 0
-        || contact_copy_room(&fm->next.model, &fm->model) != 0)
+        || prediction_room(fm) != 0)
         return report(fm, FM_ERROR, "logStatusError", "out of memory for the springpot's %lu modes (memory = 2)",
                       (unsigned long)fm->model.modes.modes);
     fm->model.max_steps = MAX_STEPS;
@@ -364,7 +407,7 @@ fm_status fm_start(fmu_model *fm, double t0, double t_stop)
      * vanishing step (0 at the start, where the striker has not touched). */
     fm->step.F_avg_next = fm->model.s.F;
     fm->predicted = fm->computed = 0;
-    fm->next.valid = 0;
+    forget_prediction(fm);
     fm->held = 0;
     fm->started = 1;
     if (contact_unused_value(&fm->params, why, sizeof why)
@@ -479,7 +522,8 @@ static double start_velocity(const fmu_model *fm, double v_end, int *other)
     v = fm->coupling == COUPLING_JACOBI ? jacobi : gauss_seidel;
     if (same_motion(fm, v, v_end))
         return v_end;
-    *other = same_motion(fm, fm->coupling == COUPLING_JACOBI ? gauss_seidel : jacobi, v_end);
+    /* (no master feeds F_avg_next where the FMU does not offer it) */
+    *other = !fm->no_prediction && same_motion(fm, fm->coupling == COUPLING_JACOBI ? gauss_seidel : jacobi, v_end);
     return *other ? v_end : v;
 }
 
@@ -488,7 +532,7 @@ static double start_velocity(const fmu_model *fm, double v_end, int *other)
  * history's grid or its limit, memory for it, or a non-finite state). */
 static void predict(fmu_model *fm, double H)
 {
-    prediction *p = &fm->next;
+    prediction *p = fm->next;
     contact_model *cm = &fm->model;
     char why[512];
     p->valid = 0;
@@ -512,9 +556,9 @@ static void predict(fmu_model *fm, double H)
  * drive and length, and no event inside when it must stop at one. */
 static int predicted_step(const fmu_model *fm, double H, unsigned stop_at, double v_end)
 {
-    const prediction *p = &fm->next;
+    const prediction *p = fm->next;
     const contact_model *cm = &fm->model;
-    return p->valid && H == p->H && cm->s.v == v_end && cm->inv_m == p->model.inv_m && cm->accel == p->model.accel
+    return p && p->valid && H == p->H && cm->s.v == v_end && cm->inv_m == p->model.inv_m && cm->accel == p->model.accel
            && !(stop_at && p->event);
 }
 
@@ -539,7 +583,7 @@ static void account_step(fmu_model *fm, double H, const contact_state *start, do
 {
     coupling_energy *e = &fm->step.energy, next;
     const contact_model *cm = &fm->model;
-    const prediction *p = &fm->next;
+    const prediction *p = fm->next; /* there under Jacobi (check_coupling) */
     const double m = proxy_mass(&fm->in);
     if (fm->coupling == COUPLING_GAUSS_SEIDEL) {
         coupling_energy_open(e, H, approach(&fm->in), bodies_accel(fm), fm->step.F_avg);
@@ -624,15 +668,15 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     save_memory(cm, &memory);
     from_prediction = predicted_step(fm, H, stop_at, v_end);
     if (from_prediction) {
-        contact_copy(cm, &fm->next.model); /* the step F_avg_next announced */
-        impulse = fm->next.impulse;
+        contact_copy(cm, &fm->next->model); /* the step F_avg_next announced */
+        impulse = fm->next->impulse;
     } else {
         impulse = contact_advance_until(cm, H, stop_at);
     }
     if (isnan(impulse)) {
         fm->step = saved;
         fm->held = held;
-        fm->next.valid = 0;
+        forget_prediction(fm);
         if (cm->exceeded)
             return report(fm, FM_ERROR, "logStatusError",
                           "DoStep: communicationStepSize = %g from t = %.17g s took more than 1e9 internal steps "
@@ -667,9 +711,10 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
     /* The next communication step, as long as this one was requested, from
      * wherever this one ended; without a prediction the average force of
      * this step, held. */
-    predict(fm, fm->step.H);
+    if (fm->next)
+        predict(fm, fm->step.H);
     fm->step.F_avg_next =
-        (fm->next.valid ? fm->next.impulse / fm->step.H : fm->step.F_avg) + fm->step.owed / fm->step.H;
+        (fm->next && fm->next->valid ? fm->next->impulse / fm->step.H : fm->step.F_avg) + fm->step.owed / fm->step.H;
     if (accounted)
         account_step(fm, part, &before, impulse, saved.owed);
     else { /* no proxy, or the rest of a step cut at an event inside the FMU: left out of the account */
@@ -682,7 +727,7 @@ fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, 
         cm->s = before;
         restore_memory(cm, &memory);
         fm->step = saved;
-        fm->next.valid = 0; /* a memo: dropping it changes no result */
+        forget_prediction(fm); /* a memo: dropping it changes no result */
         *event = 0;
         return report(fm, FM_ERROR, "logStatusError",
                       "DoStep: the output %s would be %g after [%.17g, %.17g] s (beyond double precision); "
@@ -996,7 +1041,8 @@ static fm_status refuse_state(fmu_model *fm, fmu_model *trial, const char *fmt, 
     char why[512];
     va_list args;
     contact_release_modes(&trial->model);
-    contact_release_modes(&trial->next.model);
+    if (trial->next)
+        contact_release_modes(&trial->next->model);
     va_start(args, fmt);
     vsnprintf(why, sizeof why, fmt, args);
     va_end(args);
@@ -1006,6 +1052,7 @@ static fm_status refuse_state(fmu_model *fm, fmu_model *trial, const char *fmt, 
 fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 {
     fmu_model trial = *fm;
+    prediction fresh; /* trial's, its modes in a block of its own: fm's storage takes it once the state is read */
     const unsigned char *memory = NULL;
     const char *problem;
     char why[256];
@@ -1015,7 +1062,7 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
         return report(fm, FM_ERROR, "logStatusError", "%s", problem);
     if (contact_check_params(&trial.params, why, sizeof why) != 0
         || check_bodies(&trial.params, CONTACT_SCENE_DRIVEN, &trial.in, why, sizeof why) != 0
-        || check_coupling(trial.coupling, why, sizeof why) != 0)
+        || check_coupling(&trial, trial.coupling, why, sizeof why) != 0)
         return report(fm, FM_ERROR, "logStatusError", "the FMU state holds an invalid value: %s", why);
     if (!fmu_fields_finite(&trial, state_fields, N_STATE_FIELDS)
         || !fmu_fields_finite(&trial, springpot_fields, N_SPRINGPOT_FIELDS) || (trial.started != 0 && trial.started != 1)
@@ -1031,8 +1078,11 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     /* the compressed memory's modes in blocks of trial's own, fm's kept
      * until the state is read */
     memset(&trial.model.modes, 0, sizeof trial.model.modes);
-    memset(&trial.next.model.modes, 0, sizeof trial.next.model.modes);
-    if (contact_configure(&trial.model, &trial.params) != 0 || contact_copy_room(&trial.next.model, &trial.model) != 0)
+    memset(&fresh, 0, sizeof fresh);
+    trial.next = fm->no_prediction ? NULL : &fresh;
+    if (contact_configure(&trial.model, &trial.params) != 0
+        || (trial.next && !fm->next && !(fm->next = calloc(1, sizeof *fm->next)))
+        || (trial.next && contact_copy_room(&fresh.model, &trial.model) != 0))
         return refuse_state(fm, &trial, "out of memory for the FMU state's springpot modes (memory = 2)");
     trial.model.max_steps = MAX_STEPS;
     if (nonfinite_output(&trial))
@@ -1048,9 +1098,12 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
     for (i = 0; i < count; i++)
         contact_memory_set(&trial.model, i, serial_get_double(memory + 8 * i));
     contact_release_modes(&fm->model);
-    contact_release_modes(&fm->next.model);
+    if (trial.next) { /* empty: a memo of the next step, which the next step computes again, to the bit */
+        contact_release_modes(&fm->next->model);
+        *fm->next = fresh;
+        trial.next = fm->next;
+    }
     *fm = trial;
-    fm->next.valid = 0; /* a memo of the next step: the next step computes it again, to the bit */
     return FM_OK;
 }
 
@@ -1064,5 +1117,6 @@ fm_status fm_state_read(fmu_model *fm, const unsigned char *bytes, size_t size)
 #define FM_START
 #define FM_TIME
 #define FM_STATE
-#define FM_RELEASE(fm) (contact_release(&(fm)->model), contact_release_modes(&(fm)->next.model))
+#define FM_LEAVE_OUT
+#define FM_RELEASE(fm) (contact_release(&(fm)->model), release_prediction(fm))
 #include "fmu_defaults.h"

@@ -13,13 +13,17 @@
 #define MAX_PATH_BYTES 4096
 #define MAX_TOKEN 64 /* a name's or a value's longest spelling */
 
+/* A line's value, or an output the FMU does not offer (type LEFT_OUT: the
+ * line "omit NAME"). */
+enum { LEFT_OUT = -1 };
 typedef struct {
     double value; /* an Integer's or a Boolean's too: every int is a double exactly */
     unsigned vr;
-    var_type type;
+    int type;     /* a var_type, or LEFT_OUT */
 } fixed_value;
 
-/* The values a reset sets again: those that changed the model's start. */
+/* The values a reset sets again: those that changed the model's start, and
+ * the outputs left out. */
 struct fv_values {
     const char *context; /* while the file is read, "caller: file line n", put before the model's messages */
     fi_sink sink;        /* the instance's own, which those messages then reach */
@@ -182,6 +186,10 @@ static int held(const fmu_model *fm, const fmu_variable *var, double value)
 
 static fm_status set_value(fmu_model *fm, const fixed_value *v)
 {
+    if (v->type == LEFT_OUT) {
+        fm_leave_out(fm, v->vr);
+        return FM_OK;
+    }
     if (v->type == VAR_REAL)
         return fm_set_real(fm, v->vr, v->value);
     if (v->type == VAR_INTEGER)
@@ -216,8 +224,30 @@ static int tokens(char *line, char token[3][MAX_TOKEN + 1])
 #define refuse(...) (fi_fail(in, __VA_ARGS__), 0)
 #define refuse_file(...) (fi_fail(in, __VA_ARGS__), -1)
 
+/* The line "omit NAME": the output NAME, which the exported FMU does not
+ * offer, told to the model (fm_leave_out). */
+static int take_omission(fmu_instance *in, reading *r, const char *name, int line, const char *where)
+{
+    const fmu_variable *var = named(name);
+    fixed_value *v = &in->fixed->list[in->fixed->count];
+    int *first;
+    if (!var || var->causality != VAR_OUTPUT)
+        return refuse("%s: omit %s: %s", where, name, var ? "an input or a parameter, which the FMU has to offer"
+                                                          : "no variable of this FMU has that name");
+    first = &r->lines[var - fm_variables()->list];
+    if (*first)
+        return refuse("%s: omit %s: already on line %d", where, name, *first);
+    *first = line;
+    v->vr = var->vr;
+    v->type = LEFT_OUT;
+    v->value = 0.0;
+    in->fixed->count++;
+    fm_leave_out(in->fm, var->vr);
+    return 1;
+}
+
 /* One line's value, read, checked against the earlier lines, and set
- * (or the line "guid TOKEN", kept). */
+ * (or the line "guid TOKEN", kept; or "omit NAME"). */
 static int take_line(fmu_instance *in, reading *r, char token[3][MAX_TOKEN + 1], int line, const char *where)
 {
     fv_values *fixed = in->fixed;
@@ -231,10 +261,13 @@ static int take_line(fmu_instance *in, reading *r, char token[3][MAX_TOKEN + 1],
         r->token_line = line;
         return 1;
     }
+    if (strcmp(token[0], "omit") == 0)
+        return take_omission(in, r, token[1], line, where);
     if (!var)
         return refuse("%s: no variable of this FMU is named \"%s\"", where, token[0]);
     if (var->causality == VAR_OUTPUT)
-        return refuse("%s: %s is an output, which has no value to fix", where, var->name);
+        return refuse("%s: %s is an output, which has no value to fix (\"omit %s\" leaves it out)", where,
+                      var->name, var->name);
     first = &r->lines[var - fm_variables()->list];
     if (*first)
         return refuse("%s: %s = %s: %s is already set on line %d; a variable takes one line", where, var->name,
@@ -243,7 +276,7 @@ static int take_line(fmu_instance *in, reading *r, char token[3][MAX_TOKEN + 1],
         return refuse("%s: %s = %s is not %s", where, var->name, token[1], type_rules[var->type]);
     *first = line;
     v->vr = var->vr;
-    v->type = var->type;
+    v->type = (int)var->type;
     if (held(in->fm, var, v->value))
         return 1;
     fixed->context = where;

@@ -1,7 +1,8 @@
 /* The values an exported FMU fixes (fraccontact export, docs/export.md):
  * resources/fixed_values.txt, one "name value" a line, '#' comments, ended
  * by a line "end"; a line "guid TOKEN" gives the exported FMU's own GUID or
- * instantiation token. Read at instantiation and set through the model's own
+ * instantiation token, a line "omit NAME" an output that the exported FMU
+ * does not offer (fm_leave_out: the model may skip what only it needs). Read at instantiation and set through the model's own
  * setters, as if the importer had set them; set again at every reset. A
  * FMU without the file is the full FMU. */
 #ifndef FRACCONTACT_FIXED_VALUES_H
@@ -22,7 +23,7 @@
 int fv_load(fmu_instance *in, const char *resources, int uri, const char *caller, const char *token,
             const char *what);
 
-/* fm_reset, then the fixed values again: the instance as instantiated. */
+/* fm_reset, then the fixed values and the outputs left out again: the instance as instantiated. */
 void fv_reset(fmu_instance *in);
 
 void fv_free(fmu_instance *in);

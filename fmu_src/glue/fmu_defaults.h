@@ -8,8 +8,8 @@
  *   and start_values;
  * - the macro of each hook it wrote itself: FM_SET_REAL, FM_GET_REAL,
  *   FM_SET_INTEGER, FM_GET_INTEGER, FM_SET_BOOLEAN, FM_GET_BOOLEAN,
- *   FM_SET_INPUT_DERIVATIVE, FM_GET_OUTPUT_DERIVATIVE, FM_START, FM_TIME,
- *   FM_STATE (the three of the FMU state);
+ *   FM_SET_INPUT_DERIVATIVE, FM_GET_OUTPUT_DERIVATIVE, FM_LEAVE_OUT, FM_START,
+ *   FM_TIME, FM_STATE (the three of the FMU state);
  * - what the defaults it takes call: start_state (FM_SET_REAL's, FM_START's),
  *   rule_broken (FM_SET_REAL's), rate and the string FM_RATES
  *   (FM_GET_OUTPUT_DERIVATIVE's), state_fields and state_accepted (FM_STATE's);
@@ -175,6 +175,15 @@ fm_status fm_get_output_derivative(fmu_model *fm, unsigned vr, int order, double
     return fmu_say(&fm->log, FM_ERROR, "logStatusError",
                    "fmi2GetRealOutputDerivatives: value reference %u, order %d: only " FM_RATES ", order 1", vr,
                    order);
+}
+#endif
+
+#ifndef FM_LEAVE_OUT
+/* Every output costs the same work offered or not. */
+void fm_leave_out(fmu_model *fm, unsigned vr)
+{
+    (void)fm;
+    (void)vr;
 }
 #endif
 

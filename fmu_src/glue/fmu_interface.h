@@ -59,6 +59,11 @@ enum { FM_STOP_AT_EVENT = 1, FM_CONTINUE = 2 };
 fm_status fm_do_step_until(fmu_model *fm, double t, double H, unsigned options, int *event);
 void fm_update_discrete(fmu_model *fm);
 
+/* An output the FMU does not offer (an exported FMU's modelDescription.xml
+ * leaves it out: fixed_values.h), told before initialization: the model may
+ * skip the work that only this output needs. */
+void fm_leave_out(fmu_model *fm, unsigned vr);
+
 /* The model's part of the FMU state, as fm_state_size(fm) bytes in the
  * platform-independent layout of serial.h (a model with a growing memory
  * needs more as it runs). fm_state_read takes `size` bytes back only if they

@@ -4,6 +4,7 @@ or reads, the rest fixed at given values (docs/export.md).
   fraccontact export pp.fmu --scene drop --k 3.3e8 --c 6080
   fraccontact export pp.fmu --fit fit.json --material "PP, h20 drop test" --keep c
   fraccontact export panel.fmu --scene driven --bodies 2 --coupling jacobi --fmi 3 --damper springpot
+  fraccontact export pp_me.fmu --coupling model-exchange --law hertz
 
 The exported FMU is the shipped FMU (the same Linux and Windows binaries: no
 compiler is needed) with its modelDescription.xml filtered and a file of
@@ -13,7 +14,9 @@ the full FMU's results at the same values to the last bit. What it exposes:
 the inputs the scene sets (v and m; with --bodies 2 the second body's; in the
 driven scene the accelerations of the bodies' other forces), every output
 but the other coupling's averaged force, and the variables named by --keep,
-whose start values are the values given. Every other parameter and input is
+whose start values are the values given (--coupling model-exchange: an FMU of
+Model Exchange alone, with its states, derivatives and event indicators, and
+neither averaged force). Every other parameter and input is
 fixed. Values: --NAME VALUE for any parameter or input of the FMU (the
 names of docs/variables.md, '-' for '_'), or a fit's JSON output (fraccontact
 fit --json > fit.json; --fit fit.json), which given values override. A bad
@@ -35,21 +38,26 @@ import zipfile
 
 from . import model
 from .atomic import replacing
-from .fixed_values import FIXED_VALUES
+from .fixed_values import FIXED_VALUES, OMIT
 from .options import OneLineParser
 from .shipped import fmu_path
 
 FMU_FILES = {2: "fraccontact", 3: "fraccontact-fmi3"}
 SCENES = model.WORDS["scene"]  # drop, driven
 COUPLINGS = {"gauss-seidel": 1, "jacobi": 2}  # the coupling parameter's codes
-MODEL_EXCHANGE = "model-exchange"
+MODEL_EXCHANGE = "model-exchange"  # the host's solver integrates the contact: the coupling parameter has no effect
 BODIES = (1, 2)
 # docs/two_bodies.md: the second body's inputs, and the accelerations of the
 # bodies' other forces, which only the driven scene's proxy striker reads.
 SECOND_BODY = ("v2", "m2", "a2")
 OTHER_FORCES = ("a", "a2")
-# What each coupling's master reads as the contact's force over a step.
+# What each coupling's master reads as the contact's force over a step (Model Exchange: neither).
 COUPLING_FORCE = {1: "F_avg", 2: "F_avg_next"}
+# The ModelStructure's entries of Model Exchange (FMI 2.0's sections, FMI 3.0's elements): the states'
+# derivatives, whose states they name, and the event indicators.
+MODEL_EXCHANGE_STRUCTURE = ("Derivatives", "ContinuousStateDerivative", "EventIndicator")
+# The proxy striker's inputs of the driven scene, which Model Exchange has not (the host moves the bodies).
+PROXY = ("m",)
 SCENE_OPTIONS = ("scene", "coupling")  # the FMU's parameters that --scene and --coupling set
 # A fit's JSON keys (fraccontact fit --json) that are values of the FMU, by
 # the FMU's name; E_s follows from k, which wins over it.
@@ -102,12 +110,15 @@ def full_fmu(fmi):
 
 
 def exposed_names(variables, scene, bodies, coupling, keep):
-    """The names the exported FMU keeps: the scene's inputs, its outputs, the kept ones."""
+    """The names the exported FMU keeps: the scene's inputs, its outputs, the kept ones. coupling: the
+    coupling parameter's code, None for Model Exchange (which has no proxy striker and no step's average)."""
     hidden = set()
     if bodies == 1:
         hidden.update(SECOND_BODY)
-    if scene == SCENES["drop"]:
+    if scene == SCENES["drop"] or coupling is None:
         hidden.update(OTHER_FORCES)
+    if scene == SCENES["driven"] and coupling is None:
+        hidden.update(PROXY)
     hidden.update(force for code, force in COUPLING_FORCE.items() if code != coupling)
     names = {v.name for v in variables}
     missing = sorted((hidden | set(COUPLING_FORCE.values())) - names)
@@ -222,7 +233,8 @@ def spelled(variable, value):
 
 def fixed_values_text(variables, exposed, values, title):
     """The resources file: every hidden parameter and input at its value (given or the full FMU's start), and
-    every exposed one given a value, its start in the exported FMU; in the order of modelDescription.xml."""
+    every exposed one given a value, its start in the exported FMU; in the order of modelDescription.xml; then
+    a line "omit NAME" for each output left out (without F_avg_next the binary keeps no prediction)."""
     lines = [f"# {line}" for line in title] + ["# name value (fmu_src/glue/fixed_values.c reads it at "
                                                 "instantiation)"]
     for v in variables:
@@ -230,6 +242,7 @@ def fixed_values_text(variables, exposed, values, title):
             continue
         value = values[v.name] if v.name in values else value_of(v, v.typed.get("start"))
         lines.append(f"{v.name} {spelled(v, value)}{'  # its start: tunable' if v.name in exposed else ''}")
+    lines += [f"{OMIT} {v.name}" for v in variables if v.causality == "output" and v.name not in exposed]
     return "\n".join(lines + ["end", ""])
 
 
@@ -237,6 +250,20 @@ def exported_token(full, *content):
     """The exported FMU's own GUID or instantiation token, the same for the same export: a modelDescription.xml
     of other variables is another FMU's (importers such as libcosim keep one description per GUID)."""
     return "{" + str(uuid.uuid5(uuid.UUID(full.strip("{}")), repr(content))) + "}"
+
+
+def model_exchange_names(root, fmi):
+    """The variables Model Exchange needs besides the scene's: those of the ModelStructure's
+    MODEL_EXCHANGE_STRUCTURE, and the states whose derivatives they are."""
+    variables = variables_of(root, fmi)
+    by_number = {(str(i) if fmi == 2 else v.vr): v for i, v in enumerate(variables, 1)}
+    key = "index" if fmi == 2 else "valueReference"
+    structure = root.find("ModelStructure")
+    entries = [e for e in structure.iter() if e.tag in MODEL_EXCHANGE_STRUCTURE and e.get(key) is not None]
+    entries += [e for section in structure if section.tag in MODEL_EXCHANGE_STRUCTURE for e in section]
+    named = [by_number[e.get(key)] for e in entries]
+    return {v.name for v in named} | {by_number[v.typed.get("derivative")].name for v in named
+                                      if v.typed.get("derivative") is not None}
 
 
 def renumbered(text, numbers):
@@ -275,10 +302,10 @@ def filter_structure(root, numbers, fmi):
             structure.remove(holder)
 
 
-def filtered_description(root, fmi, exposed, values, name, text, stop_time, token):
+def filtered_description(root, fmi, exposed, values, name, text, stop_time, token, interface):
     """modelDescription.xml of the exported FMU: the exposed variables, their given values as starts,
-    co-simulation only, with its name, description, default experiment and its own GUID or instantiation
-    token."""
+    the one interface ("CoSimulation" or "ModelExchange"), with its name, description, default experiment and
+    its own GUID or instantiation token."""
     variables = variables_of(root, fmi)
     holder = root.find("ModelVariables")
     numbers = {}
@@ -290,8 +317,9 @@ def filtered_description(root, fmi, exposed, values, name, text, stop_time, toke
         if v.name in values:
             v.typed.set("start", spelled(v, values[v.name]))
     filter_structure(root, numbers, fmi)
-    for interface in root.findall("ModelExchange"):
-        root.remove(interface)
+    for other in root.findall("ModelExchange") + root.findall("CoSimulation"):
+        if other.tag != interface:
+            root.remove(other)
     root.set("modelName", name)
     root.set(TOKEN[fmi], token)
     root.set("generationTool", "fraccontact export (docs/export.md)")
@@ -317,9 +345,10 @@ def fmu_bytes(source, description, fixed_text):
     return out.getvalue()
 
 
-def instantiation_error(data, fmi):
-    """The exported FMU instantiated where fmpy and a binary for this platform are at hand: None, or the
-    FMU's message refusing its fixed values."""
+def instantiation_error(data, fmi, model_exchange):
+    """The exported FMU instantiated where fmpy and a binary for this platform are at hand (for Model
+    Exchange also initialized, where the FMU applies its rules of Model Exchange): None, or the FMU's message
+    refusing its fixed values."""
     import tempfile
     try:
         from fmpy import extract, platform, platform_tuple, read_model_description
@@ -335,10 +364,17 @@ def instantiation_error(data, fmi):
         unzipped = extract(str(path), unzipdir=os.path.join(folder, "unzipped"))
         messages = []
         try:
-            instance = instantiated(md, unzipped, fmi, messages)
+            instance = (model_exchange_instance if model_exchange else instantiated)(md, unzipped, fmi, messages)
         except Exception:
             return messages[-1] if messages else "the exported FMU cannot be instantiated"
-        instance.freeInstance()
+        try:
+            if model_exchange:
+                instance.enterInitializationMode()
+                instance.exitInitializationMode()
+        except Exception:
+            return messages[-1] if messages else "the exported FMU cannot be initialized"
+        finally:
+            instance.freeInstance()
         return None
 
 
@@ -364,6 +400,39 @@ def instantiated(md, unzipped, fmi, messages):
     return fmu
 
 
+def model_exchange_instance(md, unzipped, fmi, messages):
+    """A Model Exchange instance of the unpacked FMU whose error messages land in messages."""
+    if fmi == 3:
+        from fmpy.fmi3 import FMU3Model
+
+        def log(env, status, category, message):
+            if status >= 3:
+                messages.append(message.decode())
+        fmu = FMU3Model(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.modelExchange.modelIdentifier,
+                        instanceName="export")
+        fmu.instantiate(logMessage=log)
+        return fmu
+    from ctypes import byref
+    from fmpy import calloc, free
+    from fmpy.fmi2 import (FMU2Model, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                           fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+    from fmpy.logging import addLoggerProxy
+
+    def log(env, name, status, category, message):
+        if status >= 3:
+            messages.append(message.decode())
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(log)
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    addLoggerProxy(byref(callbacks))
+    fmu = FMU2Model(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.modelExchange.modelIdentifier,
+                    instanceName="export")
+    fmu.instantiate(callbacks=callbacks)  # fmu keeps callbacks alive
+    fmu.setupExperiment(startTime=0.0)
+    return fmu
+
+
 # ---------------------------------------------------------------------------------------------------------------
 # The function and the command.
 
@@ -374,15 +443,13 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     "fixed": the fixed values' file text, "full_variables": the full FMU's count}.
 
     scene: drop or driven; bodies: 1 or 2 (the second body's m2 > 0 free); coupling: gauss-seidel or jacobi
-    (what the master feeds: F_avg after the step, F_avg_next before it); fmi: 2 or 3; values: {name: value}
+    (what the master feeds: F_avg after the step, F_avg_next before it), or model-exchange (an FMU of Model
+    Exchange alone: law 2, the dashpot or the springpot's compressed memory); fmi: 2 or 3; values: {name: value}
     of the FMU's parameters and inputs; keep: names that stay tunable; fit: a fit's JSON output (its object
     or a file's path), whose values the given ones override; source: the fit's data, for the description
     (default the fit's path); name: the modelName; material: words for the description;
     stop_time: the default experiment's. ValueError for a bad argument, naming it, its value and the rule."""
-    if coupling == MODEL_EXCHANGE:
-        raise ValueError("coupling = model-exchange: the shipped FMUs are co-simulation FMUs, without Model "
-                         "Exchange yet (use gauss-seidel or jacobi)")
-    for option, value, allowed in (("scene", scene, SCENES), ("coupling", coupling, COUPLINGS),
+    for option, value, allowed in (("scene", scene, SCENES), ("coupling", coupling, (*COUPLINGS, MODEL_EXCHANGE)),
                                    ("bodies", bodies, BODIES), ("fmi", fmi, FMU_FILES)):
         if value not in allowed or isinstance(value, bool):
             raise ValueError(f"{option} = {value!r} is invalid: it must be one of "
@@ -396,7 +463,12 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     _, root = description_of(full)
     variables = variables_of(root, fmi)
     given.update(values or {})
-    given.update(scene=SCENES[scene], coupling=COUPLINGS[coupling])
+    given.update(scene=SCENES[scene])
+    model_exchange = coupling == MODEL_EXCHANGE
+    if model_exchange and scene == "driven":
+        given.setdefault("m", 0.0)  # the rate prescribed: the host moves the bodies
+    elif not model_exchange:
+        given.update(coupling=COUPLINGS[coupling])
     unknown = [k for k in keep if k not in {v.name for v in variables if v.settable}]
     if unknown:
         raise ValueError(f"keep = {unknown[0]!r} is invalid: it must name a parameter or input of the FMU (its "
@@ -407,19 +479,23 @@ def export(path, scene="drop", bodies=1, coupling="gauss-seidel", fmi=2, values=
     if bodies == 1 and checked.get("m2", 0) != 0:
         raise ValueError(f"m2 = {checked['m2']!r} is invalid with bodies = 1: a second body of mass m2 > 0 is "
                          "bodies = 2")
-    exposed = exposed_names(variables, SCENES[scene], bodies, COUPLINGS[coupling], set(keep))
+    exposed = exposed_names(variables, SCENES[scene], bodies, COUPLINGS.get(coupling), set(keep))
+    if model_exchange:
+        exposed |= model_exchange_names(root, fmi)
     what = described(checked, scene, bodies, coupling, material)
     name = name or f"fraccontact_{word('damper', checked)}_{scene}"
     if fitted is not None:
         what.append(fit_summary(fitted, source))
     fixed = fixed_values_text(variables, exposed, checked, what)
     token = exported_token(root.get(TOKEN[fmi]), fixed, sorted(exposed), name, what, stop_time)
-    description = filtered_description(root, fmi, exposed, checked, name, "; ".join(what), stop_time, token)
+    description = filtered_description(root, fmi, exposed, checked, name, "; ".join(what), stop_time, token,
+                                       "ModelExchange" if model_exchange else "CoSimulation")
     fixed = fixed.replace("\nend\n", f"\nguid {token}\nend\n")
     data = fmu_bytes(full, description, fixed)
-    refused = instantiation_error(data, fmi)
+    refused = instantiation_error(data, fmi, model_exchange)
     if refused:
-        raise ValueError(f"the exported FMU refuses its values at instantiation: {refused}")
+        raise ValueError(f"the exported FMU refuses its values at "
+                         f"{'initialization in Model Exchange' if model_exchange else 'instantiation'}: {refused}")
     with replacing(path, "wb") as f:
         f.write(data)
     return {"path": str(path), "variables": sorted(exposed), "full_variables": len(variables), "fixed": fixed}
@@ -441,7 +517,8 @@ def build_parser(prog=None):
     p.add_argument("--bodies", type=int, choices=BODIES, default=1,
                    help="1: the specimen held (m2 = 0), 2: a free second body (v2, m2 exposed); default 1")
     p.add_argument("--coupling", choices=tuple(COUPLINGS) + (MODEL_EXCHANGE,), default="gauss-seidel",
-                   help="what the master feeds (default gauss-seidel: F_avg after the step; jacobi: F_avg_next)")
+                   help="what the master feeds (default gauss-seidel: F_avg after the step; jacobi: F_avg_next); "
+                        "model-exchange: an FMU of Model Exchange, which the host's solver integrates (law 2)")
     p.add_argument("--fmi", type=int, choices=tuple(FMU_FILES), default=2, help="FMI version (default 2)")
     p.add_argument("--fit", type=pathlib.Path, metavar="JSON", help="a fit's JSON output (fraccontact fit --json)")
     p.add_argument("--keep", nargs="+", default=[], metavar="NAME", help="variables that stay tunable")

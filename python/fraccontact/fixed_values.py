@@ -5,6 +5,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 
 FIXED_VALUES = "resources/fixed_values.txt"  # fmu_src/glue/fixed_values.h's file
+OMIT = "omit"  # its line "omit NAME": an output the exported FMU does not offer
 
 
 def fixed_of(fmu):
@@ -15,4 +16,4 @@ def fixed_of(fmu):
         lines = z.read(FIXED_VALUES).decode().splitlines()
         names = {e.get("name") for e in ET.fromstring(z.read("modelDescription.xml")).find("ModelVariables")}
     words = (line.partition("#")[0].split() for line in lines)
-    return {w[0]: w[1] for w in words if len(w) == 2}, names
+    return {w[0]: w[1] for w in words if len(w) == 2 and w[0] != OMIT}, names

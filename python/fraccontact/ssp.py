@@ -87,9 +87,13 @@ def run_libcosim(ssp, H, t_end=T_END):
           for name, index in (("contact", contact), ("striker", striker))}
     F_peak, E_diss = observer.last_real_values(contact, [vr["contact"]["F_peak"], vr["contact"]["E_diss"]])
     v_end = observer.last_real_values(striker, [vr["striker"]["v"]])[0]
-    # libcosim only warns when a binding fails to apply: report what the contact runs with
+    # libcosim only warns when a binding fails to apply: report what the contact runs with, as it reads
+    # them, or as an exported contact's file fixes them (its binary sets them)
     names = ("scene", "law", "coupling")
-    applied = dict(zip(names, observer.last_integer_values(contact, [vr["contact"][n] for n in names])))
+    read = [n for n in names if n in vr["contact"]]
+    applied = dict(zip(read, observer.last_integer_values(contact, [vr["contact"][n] for n in read]))) if read else {}
+    fixed = fixed_values(ssp, "contact") if len(read) < len(names) else {}
+    applied.update({n: int(fixed[n]) for n in names if n not in applied})
     return dict(summary(F_peak, E_diss, v_end), applied=applied)
 
 
@@ -146,13 +150,24 @@ def filter_bindings(parameter_set, component, fixed, names):
     return len(holder)
 
 
-def exposed_values(ssp, values):
-    """{component: {name: value}} of values that the SSP's FMUs expose: a value its exported FMUs fix is left
-    out, each equal to the fixed one (else ValueError). What a master sets on the SSP of a scene."""
+def component_fmus(ssp, components):
+    """{component: its FMU's bytes as a file} of the SSP's components named."""
     with zipfile.ZipFile(ssp) as z:
         ssd = ET.fromstring(z.read("SystemStructure.ssd"))
         sources = {e.get("name"): e.get("source") for e in ssd.iter() if local(e.tag) == "Component"}
-        fmus = {component: io.BytesIO(z.read(sources[component])) for component in values}
+        return {component: io.BytesIO(z.read(sources[component])) for component in components}
+
+
+def fixed_values(ssp, component):
+    """{name: value text} that the SSP's component fixes: an exported FMU's fixed values, none for a full FMU."""
+    fmu = component_fmus(ssp, [component])[component]
+    return fixed_of(fmu)[0] if FIXED_VALUES in zipfile.ZipFile(fmu).namelist() else {}
+
+
+def exposed_values(ssp, values):
+    """{component: {name: value}} of values that the SSP's FMUs expose: a value its exported FMUs fix is left
+    out, each equal to the fixed one (else ValueError). What a master sets on the SSP of a scene."""
+    fmus = component_fmus(ssp, values)
     out = {}
     for component, given in values.items():
         if FIXED_VALUES not in zipfile.ZipFile(fmus[component]).namelist():
