@@ -21,9 +21,11 @@
 #if defined(__GNUC__)
 #define HOT_INLINE inline __attribute__((always_inline))
 #define SPECIALISED __attribute__((flatten))
+#define COLD __attribute__((noinline, cold))
 #else
 #define HOT_INLINE inline
 #define SPECIALISED
+#define COLD
 #endif
 
 
@@ -78,7 +80,7 @@ static double relaxation_weight(double h_inv_B, double stiffness)
  * the bracket, bisecting where it leaves it, until a Newton step below
  * 1e-8 of X leaves the root exact to rounding: the energy a step keeps is
  * off by F times the root's residual. */
-static step_force power_mean_force(double K, double n, double theta, double x1, double rho, double b, double *X)
+static COLD step_force power_mean_force(double K, double n, double theta, double x1, double rho, double b, double *X)
 {
     double hi = x1 + rho, lo = hi - b * K * pow(larger(larger(hi, x1), 0.0), n), x = hi;
     step_force f;
@@ -133,14 +135,18 @@ static step_force power_mean_force(double K, double n, double theta, double x1, 
  * one Newton iteration to rounding; where that start is no good one (x1 =
  * 0, x1 + d < 0, or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
  * (stage_root), above the root since the force is at least (q + w)/b s^3.
- * Returns 0 where the root is X < 0. */
-static inline int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
-                                   step_force *f)
+ * Returns 0 where the root is X < 0. Inline twice (mean_force): with theta
+ * = 0.0 written out, where the step does not blend, the blend's terms fold
+ * away (its w = 0 is tested, not multiplied, as 0 * w is not 0 to the
+ * compiler). */
+static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
+                                       step_force *f)
 {
-    const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, ws0 = w * s0, c3 = 1.0 + q * s0;
-    const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = q + w;
+    const int blends = theta != 0.0;
+    const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, c3 = 1.0 + q * s0;
+    const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = blends ? q + w : q;
     /* G(s) = (((q4 s + a3) s + a2) s + c1) s + c1 s0 and its slope, by Horner */
-    const double a3 = ws0 + c3, a2 = c3 * s0, a0 = c1 * s0;
+    const double a3 = blends ? w * s0 + c3 : c3, a2 = c3 * s0, a0 = c1 * s0;
     double s = -1.0, ds;
     int i;
     if (!(c1 < 0.0))
@@ -165,7 +171,7 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
     *X = s * s;
     f->F_end = K * s * *X;
     f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
-    f->F = (1.0 - theta) * f->S + theta * f->F_end;
+    f->F = blends ? (1.0 - theta) * f->S + theta * f->F_end : f->S;
     return 1;
 }
 
@@ -183,7 +189,8 @@ static HOT_INLINE step_force mean_force(const contact_model *cm, double K, doubl
     if (n == 1.5 && x1 >= 0.0) {
         s0 = sqrt(x1);
         f.theta = theta = relaxation_weight(h_inv_B, 1.5 * K * s0);
-        if (hertz_mean_force(K, theta, x1, s0, rho, b, X, &f))
+        if (theta > 0.0 ? hertz_mean_force(K, theta, x1, s0, rho, b, X, &f)
+                        : hertz_mean_force(K, 0.0, x1, s0, rho, b, X, &f))
             return f;
     }
     f.theta = theta = x1 > 0.0 || n == 1.0 ? relaxation_weight(h_inv_B, n * K * pow(larger(x1, 0.0), n - 1.0)) : 0.0;
@@ -291,8 +298,10 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
 {
     double held = 0.0;
     const damper_stage d = compressed ? springpot_mean(cm, h, &held) : (damper_stage){0.0, cm->inv_c};
-    /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B */
-    const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (in->v + 0.5 * h * cm->accel + d.A * d.inv_B);
+    /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B, the pull A only
+     * where there is one (0 * inv_B is not 0 to the compiler) */
+    const double coast = in->v + 0.5 * h * cm->accel;
+    const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (compressed ? coast + d.A * d.inv_B : coast);
     double X;
     const step_force f = mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X);
     const double z = (f.F - d.A) * d.inv_B;
@@ -310,7 +319,9 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     out->x2 = in->x2 + h * z;
     /* what the step dissipates: the damper's work F (x2' - x2), with the
      * dashpot h F^2/c, and the blend's theta (X - x1)(F_end - S) >= 0 */
-    out->E_diss = in->E_diss + h * f.F * z + f.theta * (X - in->x1) * (f.F_end - f.S);
+    out->E_diss = in->E_diss + h * f.F * z;
+    if (f.theta > 0.0)
+        out->E_diss += f.theta * (X - in->x1) * (f.F_end - f.S);
     return h * f.F;
 }
 
