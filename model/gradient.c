@@ -17,7 +17,9 @@
 
 /* The step's root inline in it, and the dashpot's step specialised (all
  * inline, the springpot's branches gone): a call or a branch there costs
- * the fixed steps more than the noise (tests/instruction_counts.tsv). */
+ * the fixed steps more than the noise (tests/instruction_counts.tsv). The
+ * roots' rare paths (COLD) stay out of line: inline, their values would
+ * crowd the common path's out of the registers. */
 #if defined(__GNUC__)
 #define HOT_INLINE inline __attribute__((always_inline))
 #define SPECIALISED __attribute__((flatten))
@@ -119,7 +121,11 @@ static COLD step_force power_mean_force(double K, double n, double theta, double
     return f;
 }
 
-/* The same for the Hertz sphere's n = 3/2 from x1 >= 0 to X >= 0, the
+/* hertz_mean_force's fallback start, the root of s^2 + q4 s^3 = r: out of
+ * line, so that the common start keeps its values in registers. */
+static COLD double hertz_start_above(double r, double q4) { return stage_root(r, q4, 0.0); }
+
+/* power_mean_force for the Hertz sphere's n = 3/2 from x1 >= 0 to X >= 0, the
  * common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
  * (2K/5)(s^4/(s + s0) + s0 s^2 + s0^3) and the end's force K s^3, and
  * (s + s0) times the equation is
@@ -156,11 +162,11 @@ static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double
         s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
     }
     if (!(s > 0.0))
-        s = stage_root(x1 + rho, q4, 0.0);
+        s = hertz_start_above(x1 + rho, q4);
     for (i = 0; i < 200; i++) {
         const double slope = ((4.0 * q4 * s + 3.0 * a3) * s + 2.0 * a2) * s + c1;
         if (!(slope > 0.0)) { /* a start below the root where G falls: from above instead */
-            s = stage_root(x1 + rho, q4, 0.0);
+            s = hertz_start_above(x1 + rho, q4);
             continue;
         }
         ds = ((((q4 * s + a3) * s + a2) * s + c1) * s + a0) / slope;
