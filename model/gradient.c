@@ -141,12 +141,13 @@ static COLD double hertz_start_above(double r, double q4) { return stage_root(r,
  * one Newton iteration to rounding; where that start is no good one (x1 =
  * 0, x1 + d < 0, or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
  * (stage_root), above the root since the force is at least (q + w)/b s^3.
- * Returns 0 where the root is X < 0. Inline twice (mean_force): with theta
- * = 0.0 written out, where the step does not blend, the blend's terms fold
- * away (its w = 0 is tested, not multiplied, as 0 * w is not 0 to the
- * compiler). */
+ * Returns 0 where the root is X < 0, and -1 where the start is no good
+ * one and may_fall_back is 0 (the common step's, which calls nothing).
+ * Inline twice (mean_force): with theta = 0.0 written out, where the step
+ * does not blend, the blend's terms fold away (its w = 0 is tested, not
+ * multiplied, as 0 * w is not 0 to the compiler). */
 static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
-                                       step_force *f)
+                                       step_force *f, const int may_fall_back)
 {
     const int blends = theta != 0.0;
     const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, c3 = 1.0 + q * s0;
@@ -161,11 +162,16 @@ static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double
         const double g1 = 1.0 + 0.75 * bK * s0 * (1.0 + theta), d1 = (rho - bF) / g1;
         s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
     }
-    if (!(s > 0.0))
+    if (!(s > 0.0)) {
+        if (!may_fall_back)
+            return -1;
         s = hertz_start_above(x1 + rho, q4);
+    }
     for (i = 0; i < 200; i++) {
         const double slope = ((4.0 * q4 * s + 3.0 * a3) * s + 2.0 * a2) * s + c1;
         if (!(slope > 0.0)) { /* a start below the root where G falls: from above instead */
+            if (!may_fall_back)
+                return -1;
             s = hertz_start_above(x1 + rho, q4);
             continue;
         }
@@ -181,23 +187,32 @@ static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double
     return 1;
 }
 
-/* The step's force and its end X, the root of X - x1 + b F(X) = rho. */
-static HOT_INLINE step_force mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho,
-                                    double b, double *X)
+/* The step's force *f and its end X, the root of X - x1 + b F(X) = rho:
+ * 1, or 0 where common_only and the step is not the common one, the Hertz
+ * sphere's in contact from a good start (nothing written then). */
+static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho, double b,
+                                 double *X, step_force *out, const int common_only)
 {
     const double n = cm->p.spring_exponent;
     step_force f = {0.0, 0.0, 0.0, 0.0};
     double theta, s0;
+    int root;
+    if (common_only && !(K > 0.0 && n == 1.5 && x1 > 0.0))
+        return 0;
     if (!(K > 0.0)) { /* out of contact the striker moves freely */
         *X = x1 + rho;
-        return f;
+        *out = f;
+        return 1;
     }
     if (n == 1.5 && x1 >= 0.0) {
         s0 = sqrt(x1);
         f.theta = theta = relaxation_weight(h_inv_B, 1.5 * K * s0);
-        if (theta > 0.0 ? hertz_mean_force(K, theta, x1, s0, rho, b, X, &f)
-                        : hertz_mean_force(K, 0.0, x1, s0, rho, b, X, &f))
-            return f;
+        root = theta > 0.0 ? hertz_mean_force(K, theta, x1, s0, rho, b, X, &f, !common_only)
+                           : hertz_mean_force(K, 0.0, x1, s0, rho, b, X, &f, !common_only);
+        if (root > 0)
+            *out = f;
+        if (root > 0 || common_only)
+            return root > 0;
     }
     f.theta = theta = x1 > 0.0 || n == 1.0 ? relaxation_weight(h_inv_B, n * K * pow(larger(x1, 0.0), n - 1.0)) : 0.0;
     if (n == 1.0 && x1 >= 0.0) { /* a linear spring: F = K (X (1 + theta) + x1 (1 - theta))/2 while X >= 0 */
@@ -206,12 +221,14 @@ static HOT_INLINE step_force mean_force(const contact_model *cm, double K, doubl
             f.S = 0.5 * K * (*X + x1);
             f.F_end = K * *X;
             f.F = (1.0 - theta) * f.S + theta * f.F_end;
-            return f;
+            *out = f;
+            return 1;
         }
     }
     f = power_mean_force(K, n, theta, x1, rho, b, X);
     f.theta = theta;
-    return f;
+    *out = f;
+    return 1;
 }
 
 /* The springpot F = c_alpha (eta x2' + sum_i a_i phi_i), phi_i' = -b_i phi_i
@@ -295,12 +312,14 @@ void advance_modes(contact_model *cm, double h, double z)
 /* One step of length h from *in with spring stiffness K (0: no contact:
  * free flight, exact while the damper rests). Writes t, x1, x2, v, F,
  * E_diss, the damper's rate and what accepting a springpot's step needs
- * (its length and the mean rate) of *out; returns the impulse of the contact force. Inlined
- * in the dashpot's and the springpot's steps below, so that the dashpot's
- * carries none of the springpot's work: `springpot_damper` and
- * `compressed` are constants in each. */
-static inline double gradient_step_of(contact_model *cm, const contact_state *in, double h, double K,
-                                      contact_state *out, const int springpot_damper, const int compressed)
+ * (its length and the mean rate) of *out, and the impulse of the contact
+ * force in *J; returns 1, or 0 where common_only and the step is not the
+ * common one (mean_force; nothing written then). Inlined in the dashpot's
+ * and the springpot's steps below, so that the dashpot's carries none of
+ * the springpot's work: `springpot_damper`, `compressed` and `common_only`
+ * are constants in each. */
+static inline int gradient_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
+                                   double *J, const int springpot_damper, const int compressed, const int common_only)
 {
     double held = 0.0;
     const damper_stage d = compressed ? springpot_mean(cm, h, &held) : (damper_stage){0.0, cm->inv_c};
@@ -308,10 +327,11 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
      * where there is one (0 * inv_B is not 0 to the compiler) */
     const double coast = in->v + 0.5 * h * cm->accel;
     const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (compressed ? coast + d.A * d.inv_B : coast);
-    double X;
-    const step_force f = mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X);
-    const double z = (f.F - d.A) * d.inv_B;
-
+    double X, z;
+    step_force f;
+    if (!mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X, &f, common_only))
+        return 0;
+    z = (f.F - d.A) * d.inv_B;
     carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X;
@@ -328,18 +348,35 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     out->E_diss = in->E_diss + h * f.F * z;
     if (f.theta > 0.0)
         out->E_diss += f.theta * (X - in->x1) * (f.F_end - f.S);
-    return h * f.F;
+    *J = h * f.F;
+    return 1;
 }
 
+/* The dashpot's step other than the common one, out of line. */
+static COLD double any_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    double J;
+    gradient_step_of(cm, in, h, K, out, &J, 0, 0, 0);
+    return J;
+}
+
+/* The dashpot's step: the common one inline and calling nothing, so that
+ * it saves no registers across a call; any other, the same code, out of
+ * line. */
 SPECIALISED double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K,
                                          contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, 0, 0);
+    double J;
+    if (gradient_step_of(cm, in, h, K, out, &J, 0, 0, 1))
+        return J;
+    return any_dashpot_step(cm, in, h, K, out);
 }
 
 double gradient_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
+    double J;
+    gradient_step_of(cm, in, h, K, out, &J, 1, compressed_memory(cm), 0);
+    return J;
 }
 
 const contact_method_record gradient_method = {
