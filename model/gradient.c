@@ -188,8 +188,8 @@ static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double
 }
 
 /* The step's force *f and its end X, the root of X - x1 + b F(X) = rho:
- * 1, or 0 where common_only and the step is not the common one, the Hertz
- * sphere's in contact from a good start (nothing written then). */
+ * 1, or 0 where common_only and the step is not a common one, free flight
+ * or the Hertz sphere's in contact from a good start (nothing written then). */
 static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho, double b,
                                  double *X, step_force *out, const int common_only)
 {
@@ -197,7 +197,7 @@ static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv
     step_force f = {0.0, 0.0, 0.0, 0.0};
     double theta, s0;
     int root;
-    if (common_only && !(K > 0.0 && n == 1.5 && x1 > 0.0))
+    if (common_only && K > 0.0 && !(n == 1.5 && x1 > 0.0))
         return 0;
     if (!(K > 0.0)) { /* out of contact the striker moves freely */
         *X = x1 + rho;
@@ -352,7 +352,7 @@ static inline int gradient_step_of(contact_model *cm, const contact_state *in, d
     return 1;
 }
 
-/* The dashpot's step other than the common one, out of line. */
+/* The dashpot's step other than the common ones, out of line. */
 static COLD double any_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
     double J;
@@ -360,8 +360,8 @@ static COLD double any_dashpot_step(contact_model *cm, const contact_state *in, 
     return J;
 }
 
-/* The dashpot's step: the common one inline and calling nothing, so that
- * it saves no registers across a call; any other, the same code, out of
+/* The dashpot's step: the common ones inline and calling nothing, so that
+ * they save no registers across a call; any other, the same code, out of
  * line. */
 SPECIALISED double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K,
                                          contact_state *out)
