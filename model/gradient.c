@@ -125,8 +125,8 @@ static COLD step_force power_mean_force(double K, double n, double theta, double
  * line, so that the common start keeps its values in registers. */
 static COLD double hertz_start_above(double r, double q4) { return stage_root(r, q4, 0.0); }
 
-/* power_mean_force for the Hertz sphere's n = 3/2 from x1 >= 0 to X >= 0, the
- * common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
+/* power_mean_force's root for the Hertz sphere's n = 3/2 from x1 >= 0 to
+ * X >= 0, the common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
  * (2K/5)(s^4/(s + s0) + s0 s^2 + s0^3) and the end's force K s^3, and
  * (s + s0) times the equation is
  *     G(s) = (q + w) s^4 + w s0 s^3 + c3 s^2 (s + s0) + c1 (s + s0),
