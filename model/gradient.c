@@ -17,13 +17,17 @@
 
 /* The step's root inline in it, and the dashpot's step specialised (all
  * inline, the springpot's branches gone): a call or a branch there costs
- * the fixed steps more than the noise (tests/instruction_counts.tsv). */
+ * the fixed steps more than the noise (tests/instruction_counts.tsv). The
+ * roots' rare paths (COLD) stay out of line: inline, their values would
+ * crowd the common path's out of the registers. */
 #if defined(__GNUC__)
 #define HOT_INLINE inline __attribute__((always_inline))
 #define SPECIALISED __attribute__((flatten))
+#define COLD __attribute__((noinline, cold))
 #else
 #define HOT_INLINE inline
 #define SPECIALISED
+#define COLD
 #endif
 
 
@@ -78,7 +82,7 @@ static double relaxation_weight(double h_inv_B, double stiffness)
  * the bracket, bisecting where it leaves it, until a Newton step below
  * 1e-8 of X leaves the root exact to rounding: the energy a step keeps is
  * off by F times the root's residual. */
-static step_force power_mean_force(double K, double n, double theta, double x1, double rho, double b, double *X)
+static COLD step_force power_mean_force(double K, double n, double theta, double x1, double rho, double b, double *X)
 {
     double hi = x1 + rho, lo = hi - b * K * pow(larger(larger(hi, x1), 0.0), n), x = hi;
     step_force f;
@@ -117,8 +121,12 @@ static step_force power_mean_force(double K, double n, double theta, double x1, 
     return f;
 }
 
-/* The same for the Hertz sphere's n = 3/2 from x1 >= 0 to X >= 0, the
- * common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
+/* hertz_mean_force's fallback start, the root of s^2 + q4 s^3 = r: out of
+ * line, so that the common start keeps its values in registers. */
+static COLD double hertz_start_above(double r, double q4) { return stage_root(r, q4, 0.0); }
+
+/* power_mean_force's root for the Hertz sphere's n = 3/2 from x1 >= 0 to
+ * X >= 0, the common case, without pow: in s = sqrt(X), s0 = sqrt(x1), the secant is
  * (2K/5)(s^4/(s + s0) + s0 s^2 + s0^3) and the end's force K s^3, and
  * (s + s0) times the equation is
  *     G(s) = (q + w) s^4 + w s0 s^3 + c3 s^2 (s + s0) + c1 (s + s0),
@@ -133,14 +141,19 @@ static step_force power_mean_force(double K, double n, double theta, double x1, 
  * one Newton iteration to rounding; where that start is no good one (x1 =
  * 0, x1 + d < 0, or G falls there), from the root of s^2 + (q + w) s^3 = x1 + rho
  * (stage_root), above the root since the force is at least (q + w)/b s^3.
- * Returns 0 where the root is X < 0. */
-static inline int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
-                                   step_force *f)
+ * Returns 0 where the root is X < 0, and -1 where the start is no good
+ * one and may_fall_back is 0 (the common step's, which calls nothing).
+ * Inline twice (mean_force): with theta = 0.0 written out, where the step
+ * does not blend, the blend's terms fold away (its w = 0 is tested, not
+ * multiplied, as 0 * w is not 0 to the compiler). */
+static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double s0, double rho, double b, double *X,
+                                       step_force *f, const int may_fall_back)
 {
-    const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, ws0 = w * s0, c3 = 1.0 + q * s0;
-    const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = q + w;
+    const int blends = theta != 0.0;
+    const double bK = b * K, q = 0.4 * (1.0 - theta) * bK, w = theta * bK, c3 = 1.0 + q * s0;
+    const double bF = bK * x1 * s0, c1 = 0.4 * (1.0 - theta) * bF - (x1 + rho), q4 = blends ? q + w : q;
     /* G(s) = (((q4 s + a3) s + a2) s + c1) s + c1 s0 and its slope, by Horner */
-    const double a3 = ws0 + c3, a2 = c3 * s0, a0 = c1 * s0;
+    const double a3 = blends ? w * s0 + c3 : c3, a2 = c3 * s0, a0 = c1 * s0;
     double s = -1.0, ds;
     int i;
     if (!(c1 < 0.0))
@@ -149,12 +162,17 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
         const double g1 = 1.0 + 0.75 * bK * s0 * (1.0 + theta), d1 = (rho - bF) / g1;
         s = sqrt(x1 + d1 * (1.0 - 0.125 * bK * (1.0 + 2.0 * theta) * d1 / (s0 * g1)));
     }
-    if (!(s > 0.0))
-        s = stage_root(x1 + rho, q4, 0.0);
+    if (!(s > 0.0)) {
+        if (!may_fall_back)
+            return -1;
+        s = hertz_start_above(x1 + rho, q4);
+    }
     for (i = 0; i < 200; i++) {
         const double slope = ((4.0 * q4 * s + 3.0 * a3) * s + 2.0 * a2) * s + c1;
         if (!(slope > 0.0)) { /* a start below the root where G falls: from above instead */
-            s = stage_root(x1 + rho, q4, 0.0);
+            if (!may_fall_back)
+                return -1;
+            s = hertz_start_above(x1 + rho, q4);
             continue;
         }
         ds = ((((q4 * s + a3) * s + a2) * s + c1) * s + a0) / slope;
@@ -165,26 +183,36 @@ static inline int hertz_mean_force(double K, double theta, double x1, double s0,
     *X = s * s;
     f->F_end = K * s * *X;
     f->S = 0.4 * K * (*X * *X / (s + s0) + s0 * *X + s0 * x1);
-    f->F = (1.0 - theta) * f->S + theta * f->F_end;
+    f->F = blends ? (1.0 - theta) * f->S + theta * f->F_end : f->S;
     return 1;
 }
 
-/* The step's force and its end X, the root of X - x1 + b F(X) = rho. */
-static HOT_INLINE step_force mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho,
-                                    double b, double *X)
+/* The step's force *f and its end X, the root of X - x1 + b F(X) = rho:
+ * 1, or 0 where common_only and the step is not a common one, free flight
+ * or the Hertz sphere's in contact from a good start (nothing written then). */
+static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho, double b,
+                                 double *X, step_force *out, const int common_only)
 {
     const double n = cm->p.spring_exponent;
     step_force f = {0.0, 0.0, 0.0, 0.0};
     double theta, s0;
+    int root;
+    if (common_only && K > 0.0 && !(n == 1.5 && x1 > 0.0))
+        return 0;
     if (!(K > 0.0)) { /* out of contact the striker moves freely */
         *X = x1 + rho;
-        return f;
+        *out = f;
+        return 1;
     }
     if (n == 1.5 && x1 >= 0.0) {
         s0 = sqrt(x1);
         f.theta = theta = relaxation_weight(h_inv_B, 1.5 * K * s0);
-        if (hertz_mean_force(K, theta, x1, s0, rho, b, X, &f))
-            return f;
+        root = theta > 0.0 ? hertz_mean_force(K, theta, x1, s0, rho, b, X, &f, !common_only)
+                           : hertz_mean_force(K, 0.0, x1, s0, rho, b, X, &f, !common_only);
+        if (root > 0)
+            *out = f;
+        if (root > 0 || common_only)
+            return root > 0;
     }
     f.theta = theta = x1 > 0.0 || n == 1.0 ? relaxation_weight(h_inv_B, n * K * pow(larger(x1, 0.0), n - 1.0)) : 0.0;
     if (n == 1.0 && x1 >= 0.0) { /* a linear spring: F = K (X (1 + theta) + x1 (1 - theta))/2 while X >= 0 */
@@ -193,12 +221,14 @@ static HOT_INLINE step_force mean_force(const contact_model *cm, double K, doubl
             f.S = 0.5 * K * (*X + x1);
             f.F_end = K * *X;
             f.F = (1.0 - theta) * f.S + theta * f.F_end;
-            return f;
+            *out = f;
+            return 1;
         }
     }
     f = power_mean_force(K, n, theta, x1, rho, b, X);
     f.theta = theta;
-    return f;
+    *out = f;
+    return 1;
 }
 
 /* The springpot F = c_alpha (eta x2' + sum_i a_i phi_i), phi_i' = -b_i phi_i
@@ -282,21 +312,26 @@ void advance_modes(contact_model *cm, double h, double z)
 /* One step of length h from *in with spring stiffness K (0: no contact:
  * free flight, exact while the damper rests). Writes t, x1, x2, v, F,
  * E_diss, the damper's rate and what accepting a springpot's step needs
- * (its length and the mean rate) of *out; returns the impulse of the contact force. Inlined
- * in the dashpot's and the springpot's steps below, so that the dashpot's
- * carries none of the springpot's work: `springpot_damper` and
- * `compressed` are constants in each. */
-static inline double gradient_step_of(contact_model *cm, const contact_state *in, double h, double K,
-                                      contact_state *out, const int springpot_damper, const int compressed)
+ * (its length and the mean rate) of *out, and the impulse of the contact
+ * force in *J; returns 1, or 0 where common_only and the step is not the
+ * common one (mean_force; nothing written then). Inlined in the dashpot's
+ * and the springpot's steps below, so that the dashpot's carries none of
+ * the springpot's work: `springpot_damper`, `compressed` and `common_only`
+ * are constants in each. */
+static inline int gradient_step_of(contact_model *cm, const contact_state *in, double h, double K, contact_state *out,
+                                   double *J, const int springpot_damper, const int compressed, const int common_only)
 {
     double held = 0.0;
     const damper_stage d = compressed ? springpot_mean(cm, h, &held) : (damper_stage){0.0, cm->inv_c};
-    /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B */
-    const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (in->v + 0.5 * h * cm->accel + d.A * d.inv_B);
-    double X;
-    const step_force f = mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X);
-    const double z = (f.F - d.A) * d.inv_B;
-
+    /* X - x1 = h (v + h (accel - F/m)/2) - h (F - A) inv_B, the pull A only
+     * where there is one (0 * inv_B is not 0 to the compiler) */
+    const double coast = in->v + 0.5 * h * cm->accel;
+    const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (compressed ? coast + d.A * d.inv_B : coast);
+    double X, z;
+    step_force f;
+    if (!mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X, &f, common_only))
+        return 0;
+    z = (f.F - d.A) * d.inv_B;
     carry_state(out, in);
     out->t = in->t + h;
     out->x1 = X;
@@ -310,19 +345,38 @@ static inline double gradient_step_of(contact_model *cm, const contact_state *in
     out->x2 = in->x2 + h * z;
     /* what the step dissipates: the damper's work F (x2' - x2), with the
      * dashpot h F^2/c, and the blend's theta (X - x1)(F_end - S) >= 0 */
-    out->E_diss = in->E_diss + h * f.F * z + f.theta * (X - in->x1) * (f.F_end - f.S);
-    return h * f.F;
+    out->E_diss = in->E_diss + h * f.F * z;
+    if (f.theta > 0.0)
+        out->E_diss += f.theta * (X - in->x1) * (f.F_end - f.S);
+    *J = h * f.F;
+    return 1;
 }
 
+/* The dashpot's step other than the common ones, out of line. */
+static COLD double any_dashpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
+{
+    double J;
+    gradient_step_of(cm, in, h, K, out, &J, 0, 0, 0);
+    return J;
+}
+
+/* The dashpot's step: the common ones inline and calling nothing, so that
+ * they save no registers across a call; any other, the same code, out of
+ * line. */
 SPECIALISED double gradient_dashpot_step(contact_model *cm, const contact_state *in, double h, double K,
                                          contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, 0, 0);
+    double J;
+    if (gradient_step_of(cm, in, h, K, out, &J, 0, 0, 1))
+        return J;
+    return any_dashpot_step(cm, in, h, K, out);
 }
 
 double gradient_springpot_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
 {
-    return gradient_step_of(cm, in, h, K, out, 1, compressed_memory(cm));
+    double J;
+    gradient_step_of(cm, in, h, K, out, &J, 1, compressed_memory(cm), 0);
+    return J;
 }
 
 const contact_method_record gradient_method = {

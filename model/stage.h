@@ -1,6 +1,8 @@
-/* The implicit stage (docs/model.md §10): every implicit stage of the
- * steppers reduces to one scalar root X + beta X^n = r, taken inline on
- * the hot path. */
+/* The implicit stage (docs/model.md §10): each stage of ESDIRK 5(4) and
+ * each BDF2 step of the full G1 history reduces to one scalar root
+ * X + beta X^n = r, taken inline on the hot path. The fixed steps'
+ * discrete gradient solves a root of its own (gradient.c), which starts
+ * from stage_root where its own start is no good one. */
 #ifndef FRACCONTACT_STAGE_H
 #define FRACCONTACT_STAGE_H
 
@@ -11,8 +13,8 @@ double other_stage_force(const contact_model *cm, double K, double r, double bet
 /* The root s > 0 of s^2 + beta s^3 = r (r > 0, beta >= 0): s^2 is the elastic
  * indentation of an implicit stage with n = 3/2. With u = beta sqrt(r) the root is
  *     sqrt(r) (1 - u/2 + 5u^2/8 - u^3 + 231u^4/128 - 7u^5/2 + 7293u^6/1024 - 15u^7 + ...),
- * so for u < 1e-4 (every fixed step of 1e-7 s at the paper's parameters:
- * u ~ 3e-5) the series to u^4 is exact to 4e-20, below rounding; to u^6 it is as
+ * so for u < 1e-4 (a dashpot's stage of 1e-7 s at the paper's parameters)
+ * the series to u^4 is exact to 4e-20, below rounding; to u^6 it is as
  * accurate as a stage needs while its error, below 20u^7, is: while
  * u^2 < series_limit (an error-controlled step's u is about 0.01 at the
  * paper's parameters; series_limit 0: never). The even powers of u are
@@ -29,7 +31,7 @@ static inline double stage_root(double r, double beta, double series_limit)
     const double w = beta * beta * r, odd = beta * r;
     double s = sqrt(r), ds;
     int i;
-    if (w < 1e-8) /* u < 1e-4, the fixed steps' case: to u^4, exact to 4e-20 */
+    if (w < 1e-8) /* u < 1e-4, short stages: to u^4, exact to 4e-20 */
         return s * (1.0 + w * (0.625 + w * (231.0 / 128.0))) - odd * (0.5 + w);
     if (w < 0.0025) { /* u < 0.05 */
         s = s * (1.0 + w * (0.625 + w * (231.0 / 128.0 + w * (7293.0 / 1024.0)))) - odd * (0.5 + w * (1.0 + 3.5 * w));

@@ -25,6 +25,7 @@ repeated runs; CPU time of one process for 1 to 3, 5 and the per-impact costs
 of 4, wall time for 4's sweeps and fit.
 
 Regenerate: scripts/report benchmarks   (about 20 minutes)
+            scripts/report benchmarks --only steps       (section 1 alone, in place)
             scripts/report benchmarks --only precision   (section 2 alone, in place)
             scripts/report benchmarks --only package     (section 4 alone, in place)
             scripts/report benchmarks --only springpot   (section 5 alone, in place)
@@ -66,6 +67,7 @@ PROCESSES = 300  # impacts run as one fraccontact-solve process each
 REPEATS = 3
 FIT_ROWS = 1000
 BEGIN, END = "<!-- package: begin -->", "<!-- package: end -->"
+STEPS_BEGIN, STEPS_END = "<!-- step costs: begin -->", "<!-- step costs: end -->"
 SPRINGPOT_BEGIN, SPRINGPOT_END = "<!-- springpot: begin -->", "<!-- springpot: end -->"
 CONTROLLED_BEGIN, CONTROLLED_END = "<!-- controlled springpot: begin -->", "<!-- controlled springpot: end -->"
 CONTROLLED_TOLERANCES = (1e-6, 1e-8)
@@ -128,6 +130,37 @@ def first_setting_that_stays_within(settings, error):
 
 def step_costs(bench):
     return run(bench, "step")
+
+
+def steps_section(steps):
+    """Section 1, between its markers: the ns per internal step of each
+    spring law, the literal O(N) sum's, and the 1-minute load while it ran."""
+    h = steps["ns_per_step"]
+    lit = steps["ns_literal_sum"]
+    out = [STEPS_BEGIN, "## Cost of an internal step", "",
+           "Regenerate this section alone, in place: `scripts/report benchmarks --only steps` (under a minute; "
+           f"this run's 1-minute load average {steps['load']:.2f} on {os.cpu_count()} cores). "
+           "The h20 contact (dt = 1e-7 s, 13 160 steps), 100 internal steps per `contact_advance` call as the FMU "
+           "takes them with a 10 us communication step (`fraccontact-bench step`).", "",
+           "| spring law | ns per internal step |", "|---|---|",
+           f"| G1, O(1) closed form of the straight-line sum (law 1) | {h['g1']:.1f} |",
+           f"| Hertz (law 2) | {h['hertz']:.1f} |",
+           f"| G1 + Richardson, two closed forms (law 3) | {h['g1x']:.1f} |", "",
+           "The literal O(N) G1 sum, which the closed form replaces (and is tested against to 1e-12), costs per "
+           "evaluation:", "",
+           "| N | ns per literal sum | as a share of a law-1 step |", "|---|---|---|"]
+    for N, ns in lit.items():
+        out.append(f"| {int(N):,} | {ns:.0f} | {ns / h['g1']:.0f}x |")
+    total = sum(lit["13160"] * n / 13160 for n in range(1, 13161)) * 1e-9
+    return out + ["", f"Summed literally at every step (N = steps since onset), an h20 impact at dt = 1e-7 s would "
+                  f"cost about {total:.1f} s instead of {h['g1'] * 13160 * 1e-6:.2f} ms.", "", STEPS_END]
+
+
+def measured_steps(bench):
+    """step_costs, with the load it ran under."""
+    with LoadWatch() as load:
+        steps = step_costs(bench)
+    return dict(steps, load=float(np.median(load.samples)))
 
 
 # --- 2. work against precision ---------------------------------------------------
@@ -1276,8 +1309,6 @@ def instructions_section(r):
 
 
 def write(path, steps, precision, g1, alpha, package, springpot, controlled):
-    h = steps["ns_per_step"]
-    lit = steps["ns_literal_sum"]
     out = ["# Benchmarks", "",
            f"{REGENERATE}. Everything below was measured side by side "
            f"in one run, on {platform.processor() or platform.machine()} ({platform.system()}), one process, "
@@ -1287,21 +1318,8 @@ def write(path, steps, precision, g1, alpha, package, springpot, controlled):
                "The sweep at scale (`fraccontact sweep` end to end against the C core, one worker and "
                "two, the serial fraction, the client's memory): [sweep_scaling.md](sweep_scaling.md), regenerated "
                "by `scripts/report sweep_scaling`."]), "",
-           "## Cost of an internal step", "",
-           "The h20 contact (dt = 1e-7 s, 13 160 steps), 100 internal steps per `contact_advance` call as the FMU "
-           "takes them with a 10 us communication step (`fraccontact-bench step`).", "",
-           "| spring law | ns per internal step |", "|---|---|",
-           f"| G1, O(1) closed form of the straight-line sum (law 1) | {h['g1']:.1f} |",
-           f"| Hertz (law 2) | {h['hertz']:.1f} |",
-           f"| G1 + Richardson, two closed forms (law 3) | {h['g1x']:.1f} |", "",
-           "The literal O(N) G1 sum, which the closed form replaces (and is tested against to 1e-12), costs per "
-           "evaluation:", "",
-           "| N | ns per literal sum | as a share of a law-1 step |", "|---|---|---|"]
-    for N, ns in lit.items():
-        out.append(f"| {int(N):,} | {ns:.0f} | {ns / h['g1']:.0f}x |")
-    total = sum(lit["13160"] * n / 13160 for n in range(1, 13161)) * 1e-9
-    out += ["", f"Summed literally at every step (N = steps since onset), an h20 impact at dt = 1e-7 s would cost "
-            f"about {total:.1f} s instead of {h['g1'] * 13160 * 1e-6:.2f} ms.", ""] + precision
+           *steps_section(steps), ""]
+    out += precision
     out += ["", f"## G1 history sum of f(x) = x, alpha = {alpha}, against differint 1.0.0", "",
             "N intervals of [0, 1]. Newest point: `g1_history_sum` (weights included) against "
             "`differint.GLpoint`; full grid: `g1_full_grid` (zero-padded FFT, the first N/128 points summed "
@@ -1519,9 +1537,10 @@ def main(argv=None, prog=None):
     parser = output.parser(prog, __doc__)
     output.add_solver(parser, "fraccontact-solve; fraccontact-bench is beside it")
     output.add_fmu(parser)
-    parser.add_argument("--only", choices=["precision", "package", "springpot", "controlled", "instructions",
+    parser.add_argument("--only", choices=["steps", "precision", "package", "springpot", "controlled", "instructions",
                                            "exchange"],
-                        help="regenerate one section alone, in place (precision: work against precision on all four "
+                        help="regenerate one section alone, in place (steps: the ns per internal step of each "
+                             "spring law; precision: work against precision on all four "
                              "figures, and the FMU's one-doStep impact; package: the Python package against the C "
                              "core; springpot: the springpot's memories, and the dashpot against the commit before "
                              "them; controlled: the springpot against the dashpot under error control; "
@@ -1532,6 +1551,11 @@ def main(argv=None, prog=None):
                         help="the springpot ladder's largest N (default 1e6; smaller for a quick look)")
     args = output.parse(parser, argv)
     program, bench = args.solver, solver.bench_path(args.solver)
+    if args.only == "steps":
+        say("cost of a step ...")
+        replace_section(args.out / "benchmarks.md", steps_section(measured_steps(bench)), STEPS_BEGIN, STEPS_END)
+        print((args.out / "benchmarks.md").read_text())
+        return
     if args.only == "precision":
         say("work against precision ...")
         section = precision(source_tree(), program, bench, args.fmu, args.out)
@@ -1569,7 +1593,7 @@ def main(argv=None, prog=None):
         return
     root = source_tree()
     say("1/5 cost of a step ...")
-    steps = step_costs(bench)
+    steps = measured_steps(bench)
     say("2/5 work against precision ...")
     precision_lines = precision(root, program, bench, args.fmu, args.out)
     say("3/5 G1 against differint ...")

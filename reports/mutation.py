@@ -144,7 +144,7 @@ MUTANTS = [
            "2e-8; test_contact test_energy_balance to rounding, "
            "test_solver::test_one_impact_per_impact_figures_match_the_closed_forms: "
            "E_diss = m v0² (1 - eps²)/2 rel 1e-8",
-           (GRADIENT, "out->E_diss = in->E_diss + h * f.F * z +", "out->E_diss = in->E_diss + h * f.F * z * (1.0 + 2e-8) +")),
+           (GRADIENT, "out->E_diss = in->E_diss + h * f.F * z;", "out->E_diss = in->E_diss + h * f.F * z * (1.0 + 2e-8);")),
     mutant("gradient-secant", "time scheme", "fixed step, n = 3/2: the secant's s0³ term ×(1 + 1e-6), "
            "the mean force off its discrete gradient",
            "the spring's energy off by up to 4e-7 F dx1 a step; test_contact test_energy_balance to rounding",
