@@ -10,6 +10,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 INSTANTIATE, FREE, SETUP, ENTER, EXIT, TERMINATE, RESET, SET_REAL, SET_INT = range(9)
 OUTPUTS, STEP, GET_STATE, SET_STATE, FREE_STATE, SERIALIZE, DESERIALIZE, IN_DER, OUT_DER = range(10, 19)
 LOGGING, STRINGS, STATUSES, GET_INT_BOOL = 19, 20, 21, 22
+INSTANTIATE_ME, ME_EVALUATE, ME_MODE = 23, 24, 25  # Model Exchange: the instance, a solver's evaluation, a mode
 # indices into the harness's tables
 V = {0.0: 0, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
 REF = {1: 0, 2: 1, 9: 8, 10: 9, 11: 10, 12: 11, 13: 12, 30: 22, 31: 23, 32: 24, 40: 25, 23: 29, 24: 30, 25: 31,
@@ -46,6 +47,10 @@ SEEDS = {
     "springpot_full_history": start(params=bytes([SET_INT, REF[33], 2, SET_INT, REF[34], 1, SET_REAL, REF[10], V[1e-5]]))
     + steps(20) + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5)
     + bytes([TERMINATE, FREE]),
+    # law 2, through the initial event into continuous time, the striker moved into the specimen and out
+    "model_exchange": bytes([INSTANTIATE_ME, 1, SETUP, V[0.0], ENTER, SET_INT, REF[30], 2, EXIT, ME_MODE, 1, ME_MODE, 2])
+    + bytes([ME_EVALUATE, 0, V[1e-4], V[1e-4], ME_MODE, 0, ME_MODE, 1, ME_MODE, 2, ME_MODE, 3, OUTPUTS, GET_STATE])
+    + bytes([ME_EVALUATE, 0]) + raw(-1e-3) + bytes([V[1e-3], ME_MODE, 0, ME_MODE, 1, SET_STATE, 0, TERMINATE, FREE]),
     "out_of_order": bytes([STEP, V[1e-4], 0, EXIT, TERMINATE, INSTANTIATE, 0, STEP, V[1e-4], 0, OUTPUTS, EXIT,
                            GET_STATE, SERIALIZE, TERMINATE, ENTER, SET_INT, REF[30], 7, EXIT, EXIT, STEP, V[1e-4], 0,
                            ENTER, FREE_STATE, 0, FREE, FREE]),
