@@ -12,9 +12,9 @@ OUTPUTS, STEP, GET_STATE, SET_STATE, FREE_STATE, SERIALIZE, DESERIALIZE, IN_DER,
 LOGGING, STRINGS, STATUSES, GET_INT_BOOL = 19, 20, 21, 22
 INSTANTIATE_ME, ME_EVALUATE, ME_MODE = 23, 24, 25  # Model Exchange: the instance, a solver's evaluation, a mode
 # indices into the harness's tables
-V = {0.0: 0, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
+V = {0.0: 0, 1.0: 2, -1.0: 3, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
 REF = {1: 0, 2: 1, 9: 8, 10: 9, 11: 10, 12: 11, 13: 12, 30: 22, 31: 23, 32: 24, 40: 25, 23: 29, 24: 30, 25: 31,
-       26: 32, 33: 33, 34: 34}
+       26: 32, 33: 33, 34: 34, 27: 37, 36: 38, 37: 39, 38: 40, 39: 41}
 
 
 def raw(x):
@@ -47,6 +47,19 @@ SEEDS = {
     "springpot_full_history": start(params=bytes([SET_INT, REF[33], 2, SET_INT, REF[34], 1, SET_REAL, REF[10], V[1e-5]]))
     + steps(20) + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5)
     + bytes([TERMINATE, FREE]),
+    # error-controlled steps (tolerance > 0): ESDIRK 5(4) for the dashpot, Radau IIA for the springpot
+    "dashpot_controlled": start(params=bytes([SET_INT, REF[30], 2, SET_REAL, REF[27], V[1e-5]])) + steps(20)
+    + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(50) + bytes([TERMINATE, FREE]),
+    # a linear spring (the stage's root for n other than 3/2) through the separation, and a driven proxy striker
+    # between two bodies under other forces (the coupling's energy account)
+    "linear_spring_to_separation": start(params=bytes([SET_REAL, REF[23], V[1.0]])) + steps(70) + bytes([OUTPUTS]),
+    "driven_proxy_two_bodies": start(params=bytes([SET_INT, REF[32], 2, SET_REAL, REF[37], V[1e3]]))
+    + bytes([SET_REAL, REF[38], V[9.81]]) + steps(30) + bytes([OUTPUTS, RESET, FREE]),
+    "springpot_controlled": start(params=bytes([SET_INT, REF[30], 2, SET_INT, REF[33], 2, SET_REAL, REF[27],
+                                                V[1e-5]])) + steps(20)
+    + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5) + bytes([TERMINATE, FREE]),
+    "two_free_bodies": start(params=bytes([SET_REAL, REF[37], V[0.7437], SET_REAL, REF[36], V[-1.0]])) + steps(20)
+    + bytes([OUTPUTS, RESET, FREE]),
     # law 2, through the initial event into continuous time, the striker moved into the specimen and out
     "model_exchange": bytes([INSTANTIATE_ME, 1, SETUP, V[0.0], ENTER, SET_INT, REF[30], 2, EXIT, ME_MODE, 1, ME_MODE, 2])
     + bytes([ME_EVALUATE, 0, V[1e-4], V[1e-4], ME_MODE, 0, ME_MODE, 1, ME_MODE, 2, ME_MODE, 3, OUTPUTS, GET_STATE])
@@ -122,6 +135,10 @@ SEEDS3 = {
                                     + raw(5e-324) + bytes([F3_SET_REAL, REF[1]]) + raw(1e300) + GAP)
     + f3_steps(3, 1e3, events=True) + bytes([F3_STEP, V[1e-5], 1]) + raw(0.5) + bytes([0, F3_OUTPUTS])
     + bytes([F3_STEP, V[1e-5], 1]) + raw(float("nan")) + bytes([0]),
+    "fmi3_springpot_controlled": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[30], 2, F3_SET_INT,
+                                                                                   REF[33], 2, F3_SET_REAL, REF[27],
+                                                                                   V[1e-5]]) + GAP)
+    + f3_steps(20, events=True) + STATE_ROUND_TRIP + f3_steps(5) + bytes([F3_TERMINATE, F3_FREE]),
     "fmi3_springpot_full_history": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[33], 2, F3_SET_INT,
                                                                                      REF[34], 1, F3_SET_REAL, REF[10],
                                                                                      V[1e-5]]) + GAP)
