@@ -78,6 +78,7 @@ print(f"wrote {len(SEEDS)} seeds to {HERE / 'fuzz_corpus'}")
 F3_INSTANTIATE, F3_FREE, F3_ENTER, F3_EXIT, F3_EVENT_MODE, F3_UPDATE, F3_STEP_MODE, F3_TERMINATE = range(8)
 F3_RESET, F3_SET_REAL, F3_SET_INT, F3_SET_BOOL, F3_OUTPUTS, F3_STEP, F3_GET_STATE, F3_SET_STATE = range(8, 16)
 F3_FREE_STATE, F3_SERIALIZE, F3_DESERIALIZE, F3_OUT_DER, F3_LOGGING, F3_REFUSED, F3_GET_INT_BOOL = range(16, 23)
+F3_INSTANTIATE_ME, F3_ME_EVALUATE, F3_ME_MODE = 23, 24, 25  # as FMI 2.0's; a mode: 1 continuous time, 0 a step done
 # F3_INSTANTIATE's flags byte
 LOGGING_ON, EVENT_MODE, EARLY_RETURN, CALLBACK = 1, 2, 4, 8
 WRONG_TOKEN, EMPTY_NAME, REQUIRED_VARIABLES = 0x10, 0x20, 0x40
@@ -139,6 +140,11 @@ SEEDS3 = {
                                                                                    REF[33], 2, F3_SET_REAL, REF[27],
                                                                                    V[1e-5]]) + GAP)
     + f3_steps(20, events=True) + STATE_ROUND_TRIP + f3_steps(5) + bytes([F3_TERMINATE, F3_FREE]),
+    # law 2, through the initial event into continuous time, the striker moved into the specimen and out
+    "fmi3_model_exchange": bytes([F3_INSTANTIATE_ME, 1, F3_ENTER, V[0.0], 0, V[0.0], F3_SET_INT, REF[30], 2, F3_EXIT,
+                                  F3_UPDATE, F3_ME_MODE, 1, F3_ME_EVALUATE, 0, V[1e-4], V[1e-4], F3_ME_MODE, 0,
+                                  F3_EVENT_MODE, F3_UPDATE, F3_ME_MODE, 1, F3_OUTPUTS, F3_GET_STATE, F3_ME_EVALUATE, 0])
+    + raw(-1e-3) + bytes([V[1e-3], F3_ME_MODE, 0, F3_EVENT_MODE, F3_UPDATE, F3_SET_STATE, 0, F3_TERMINATE, F3_FREE]),
     "fmi3_springpot_full_history": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[33], 2, F3_SET_INT,
                                                                                      REF[34], 1, F3_SET_REAL, REF[10],
                                                                                      V[1e-5]]) + GAP)
