@@ -122,7 +122,7 @@ def mutation_section(path):
 # tests/test_reliability_claims.py reads both.
 FUZZ_BUDGET = ("Each input's work is bounded (`tests/fuzz_program.h`): at most 1,024 internal steps in all its "
                "steps of dt_max and 262,144 terms of a full G1 history's sums, and the fuzzers build the FMU with "
-               "a limit of 16,384 internal steps a communication step (its own is 1e9), which a light striker's "
+               "a limit of 4,096 internal steps a communication step with the sanitizers and 16,384 without (its own is 1e9), which a light striker's "
                "contact (refined far below dt_max) or error-controlled steps (not capped by dt_max) would otherwise "
                "pass; so no input runs long (`fuzz_replay "
                "-timeout=1` fails one that takes a second of CPU, in every build). CI fuzzes each harness for 30 s "

@@ -94,10 +94,11 @@ def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
     in the fuzzers and its own, the seconds and
     the floors of the fuzz tests as CMake and scripts/test set them, and the
     count CI runs at least, which follows from them."""
-    steps, terms, limit, own, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
+    steps, terms, sanitized_limit, plain_limit, own, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
         r"Each input's work is bounded \(`tests/fuzz_program.h`\): at most ([\d,]+) internal steps in all its steps "
         r"of dt_max and ([\d,]+) terms of a full G1 history's sums, and the fuzzers build the FMU with a limit of "
-        r"([\d,]+) internal steps a communication step \(its own is (\S+)\), which a light striker's contact "
+        r"([\d,]+) internal steps a communication step with the sanitizers and ([\d,]+) without \(its own is (\S+)\), "
+        r"which a light striker's contact "
         r"\(refined far below dt_max\) or error-controlled steps \(not capped by dt_max\) would otherwise pass; so no "
         r"input runs long \(`fuzz_replay -timeout=(\d+)` "
         r"fails one that takes a second of CPU, in every build\)\. CI fuzzes each harness for (\d+) s with ASan and "
@@ -110,7 +111,9 @@ def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
     assert float(re.search(r"#define BUDGET_TERMS ([\d.]+)", program).group(1)) == n(terms)
     cmake = (ROOT / "CMakeLists.txt").read_text()
     fuzzer = cmake[cmake.index("function(add_fmi_fuzzer"):cmake.index("endfunction()", cmake.index("function(add_fmi_fuzzer"))]
-    assert re.findall(r"MAX_STEPS=(\d+)", fuzzer) == [limit.replace(",", "")]
+    limits = [sanitized_limit.replace(",", ""), plain_limit.replace(",", "")]
+    assert re.findall(r"set\(max_steps (\d+)\)", fuzzer) == limits
+    assert "MAX_STEPS=${max_steps}" in fuzzer
     glue = (ROOT / "fmu_src" / "binding" / "fmu_model.c").read_text()
     assert float(re.search(r"#define MAX_STEPS (\d+)", glue).group(1)) == float(own)
     assert re.findall(r"set\(floor (\d+)\)", fuzzer) == [sanitized_floor.replace(",", ""), plain_floor.replace(",", "")]
