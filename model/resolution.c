@@ -1,7 +1,8 @@
 /* Whether fixed steps resolve an impact: the time a striker takes to stop,
  * the uniform grids' check of dt_max against it, the warning where the
- * fixed steps are refined in contact, the fixed step of a contact, and the
- * check that an advance takes no more steps than a caller allows. */
+ * fixed steps are refined in contact and the refusal where those cannot
+ * stop the striker, the fixed step of a contact, and the check that an
+ * advance takes no more steps than a caller allows. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
