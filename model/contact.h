@@ -344,8 +344,10 @@ int contact_arrival_warning(const contact_params *p, double v, char *msg, size_t
 /* Whether the uniform grids (the central scheme, the full G1 history),
  * whose steps cannot shorten in contact, resolve the first impact of a
  * striker of mass m starting at v (the fastest: CONTACT_RESOLUTION steps
- * while the spring stops the striker). 0, or -1 and a message naming
- * dt_max, its value and the rule. */
+ * while the spring stops the striker), and whether the fixed steps that are
+ * refined in contact instead can stop it (their first indentation and force
+ * normal numbers). 0, or -1 and a message naming dt_max (or m and v), the
+ * values and the rule. */
 int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len);
 
 /* A warning where fixed steps of dt_max do not resolve that impact and are
@@ -428,8 +430,10 @@ int contact_check_advance(const contact_model *cm, double H, char *msg, size_t l
  * state: from the free flight's onset inside the advance, or from now in
  * contact, until a striker with inertia can have turned back or a
  * prescribed rate reverses (none where nothing bounds it); for the full G1
- * history the work of its steps (contact_history_work) instead. 0, or -1
- * and a message naming dt_max or memory, its value and the rule. */
+ * history the work of its steps (contact_history_work) instead; and that
+ * refined fixed steps in the coming contact advance the clock and can stop
+ * the striker (contact_check_resolution). 0, or -1 and a message naming
+ * dt_max, memory or m and v, the values and the rule. */
 int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len);
 
 /* Whether the full G1 history (memory = 1) holds a run from the start that

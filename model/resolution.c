@@ -1,7 +1,9 @@
 /* Whether fixed steps resolve an impact: the time a striker takes to stop,
  * the uniform grids' check of dt_max against it, the warning where the
- * fixed steps are refined in contact, the fixed step of a contact, and the
- * check that an advance takes no more steps than a caller allows. */
+ * fixed steps are refined in contact and the refusal where those cannot
+ * stop the striker, the fixed step of a contact, and the check that an
+ * advance takes no more steps than a caller allows. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -46,20 +48,67 @@ static double stopping_time(const contact_params *p, double K, double inv_m, dou
     return fmax(turnaround_time(p->spring_exponent, K, inv_m, v, a), damper_time(p, inv_m));
 }
 
+/* The speed at which a striker starting at v reaches the specimen, falling
+ * through the gap gap0 under g (0 where it does not arrive). */
+static double arrival_speed(const contact_params *p, double v)
+{
+    const double fall = 2.0 * p->g * p->gap0, s = sqrt(fabs(fall));
+    if (!(v > 0.0 || p->g > 0.0))
+        return 0.0;
+    if (fall >= 0.0)
+        return hypot(v, s); /* not from v^2, which underflows for a tiny v */
+    return v > s ? sqrt((v - s) * (v + s)) : 0.0;
+}
+
 /* The stopping time (above) of the first impact of a striker of mass m
  * starting at v: the fastest, since the striker arrives at v (or falls
  * through the gap under g) and every impact after loses speed. */
 static double first_turnaround(const contact_params *p, double v, double m)
 {
-    const double v2 = v > 0.0 || p->g > 0.0 ? v * v + 2.0 * p->g * p->gap0 : 0.0;
     if (!(m > 0.0))
         return INFINITY;
-    return stopping_time(p, spring_constant(p), 1.0 / m, v2 > 0.0 ? sqrt(v2) : 0.0, p->g);
+    return stopping_time(p, spring_constant(p), 1.0 / m, arrival_speed(p, v), p->g);
 }
 
 /* Whether the method shortens its fixed steps in a contact they do not
  * resolve: neither a uniform grid nor error-controlled steps do. */
 static int refines_fixed_steps(const contact_method_record *m) { return !m->uniform_grid && !m->controls_error; }
+
+/* Why the refined fixed steps (`step`, shorter than dt_max) of a contact
+ * from the indentation x1 at the rate `rate` under the load a, up to t_end,
+ * cannot stop the striker, or NULL: each must advance the clock, and the
+ * first must indent the specimen and push back by normal numbers where the
+ * striker moves in (or a load presses it in). Else the
+ * spring never acts (or the clock never moves), the contact never ends and
+ * the steps run to the step limit, which no estimate of the least work
+ * (that counts on the striker stopping in its turnaround time) foresees. */
+static const char *refined_fault(const contact_params *p, double K, double x1, double rate, double a, double step,
+                                 double t_end, char why[96])
+{
+    const double first = x1 + fmax(rate, 0.0) * step + 0.5 * fmax(a, 0.0) * step * step;
+    const double F = K * pow(first, p->spring_exponent);
+    char text[32];
+    if (!(step > 4.0 * DBL_EPSILON * fabs(t_end)))
+        snprintf(why, 96, "which do not advance the clock at t = %.17g s", t_end);
+    else if ((rate > 0.0 || a > 0.0) && !(first >= DBL_MIN && F >= DBL_MIN))
+        snprintf(why, 96, "the first indenting by %s m with %.3g N, below the normal doubles: never stopping it",
+                 shown(first, text), F);
+    else
+        return NULL;
+    return why;
+}
+
+/* The refusal of a striker of mass m at v whose contact's refined steps
+ * cannot stop it (refined_fault: why), `from` saying where. */
+static int reject_refined(double m, double v, double step, const char *from, const char *why, char *msg, size_t len)
+{
+    char text[2][32];
+    snprintf(msg, len,
+             "m = %s, v = %s are invalid%s: the spring stops the striker in %.3g s, resolved in %d steps of "
+             "%.3g s, %s; raise m or v",
+             shown(m, text[0]), shown(v, text[1]), from, step * CONTACT_REFINED, CONTACT_REFINED, step, why);
+    return -1;
+}
 
 /* "dt_max = 0 (fixed steps of 1e-07 s)" or "dt_max = 2e-07": the step as given. */
 static const char *shown_step(const contact_params *p, char text[64])
@@ -75,9 +124,15 @@ static const char *shown_step(const contact_params *p, char text[64])
 int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len)
 {
     const double t = first_turnaround(p, v, m);
-    const char *grid = method_record(p)->uniform_grid;
-    char text[3][64];
-    if (!grid || !(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+    const char *grid = method_record(p)->uniform_grid, *fault;
+    char text[3][64], why[96];
+    if (!(t < CONTACT_RESOLUTION * contact_step_limit(p)))
+        return 0;
+    if (refines_fixed_steps(method_record(p))) {
+        fault = refined_fault(p, spring_constant(p), 0.0, arrival_speed(p, v), p->g, t / CONTACT_REFINED, 0.0, why);
+        return fault ? reject_refined(m, v, t / CONTACT_REFINED, "", fault, msg, len) : 0;
+    }
+    if (!grid)
         return 0;
     snprintf(msg, len,
              "%s is invalid with m = %s, v = %s: the spring stops the striker in %.3g s, which the %s uniform grid "
@@ -100,6 +155,13 @@ int contact_step_warning(const contact_params *p, double v, double m, char *msg,
              shown_step(p, text[0]), shown(m, text[1]), shown(v, text[2]), t, CONTACT_RESOLUTION,
              t / CONTACT_REFINED, CONTACT_REFINED);
     return 1;
+}
+
+/* The fixed step of a contact whose onset speed is v (resolve_contact). */
+static double contact_step_at(const contact_model *cm, double v)
+{
+    const double t = stopping_time(&cm->p, cm->k, cm->inv_m, v, cm->accel);
+    return !refines_fixed_steps(cm->method) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max : t / CONTACT_REFINED;
 }
 
 /* The least time an advance by H from the model's state spends in contact
@@ -147,21 +209,46 @@ static int check_history_work(const contact_model *cm, double H, double max_work
     return -1;
 }
 
+/* The contact an advance by H meets: the striker's speed at its onset (the
+ * model's onset speed while in contact), or -1 where it meets none. */
+static double onset_speed(const contact_model *cm, double H)
+{
+    const contact_state *s = &cm->s;
+    double onset;
+    if (s->in_contact)
+        return s->v_onset;
+    onset = flight_onset(s->x1, s->v, cm->accel, H);
+    return onset < 0.0 ? -1.0 : s->v + cm->accel * onset;
+}
+
 int contact_check_work(const contact_model *cm, double H, double max_steps, char *msg, size_t len)
 {
-    double steps;
-    char text[64];
+    double steps, v, step = cm->h_max;
+    char text[64], why[96], from[64];
     if (full_history(cm))
         return check_history_work(cm, H, max_steps, msg, len);
-    if (!(H / cm->h_max > max_steps)) /* not even all of it in contact: the common case, known at once */
+    v = onset_speed(cm, H);
+    if (v >= 0.0)
+        step = cm->s.in_contact ? cm->contact_step : contact_step_at(cm, v);
+    if (step < cm->h_max) {
+        const double rate = cm->s.in_contact ? cm->s.v : v;
+        const char *fault = refined_fault(&cm->p, cm->k, fmax(cm->s.x1, 0.0), rate, cm->accel, step, cm->s.t + H,
+                                          why);
+        if (fault) {
+            snprintf(from, sizeof from, " for this advance from t = %.17g s", cm->s.t);
+            return reject_refined(1.0 / cm->inv_m, v, step, from, fault, msg, len);
+        }
+    }
+    if (!(H / step > max_steps)) /* not even all of it in contact: the common case, known at once */
         return 0;
-    steps = contact_least_steps(&cm->p, H, least_contact(cm, H));
+    /* in steps of the contact's (refined) step, not of dt_max */
+    steps = contact_least_steps(&cm->p, H, least_contact(cm, H)) * (cm->h_max / step);
     if (!(steps > max_steps))
         return 0;
     snprintf(msg, len,
              "%s is invalid for this advance from t = %.17g s: it would take at least %.3g internal steps of at most "
              "%.3g s, more than %.0e; raise dt_max, or take shorter advances (communication steps)",
-             shown_step(&cm->p, text), cm->s.t, steps, cm->h_max, max_steps);
+             shown_step(&cm->p, text), cm->s.t, steps, step, max_steps);
     return -1;
 }
 
@@ -173,7 +260,5 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
  * or the inertia change. */
 void resolve_contact(contact_model *cm)
 {
-    const double t = stopping_time(&cm->p, cm->k, cm->inv_m, cm->s.v_onset, cm->accel);
-    cm->contact_step = !refines_fixed_steps(cm->method) || t >= CONTACT_RESOLUTION * cm->h_max ? cm->h_max
-                                                                                               : t / CONTACT_REFINED;
+    cm->contact_step = contact_step_at(cm, cm->s.v_onset);
 }

@@ -121,7 +121,10 @@ def mutation_section(path):
 # the fuzz tests' floors (CMakeLists.txt, add_fmi_fuzzer; tests/fuzz_rate.py):
 # tests/test_reliability_claims.py reads both.
 FUZZ_BUDGET = ("Each input's work is bounded (`tests/fuzz_program.h`): at most 1,024 internal steps in all its "
-               "steps and 262,144 terms of a full G1 history's sums, so that no input runs long (`fuzz_replay "
+               "steps of dt_max and 262,144 terms of a full G1 history's sums, and the fuzzers build the FMU with "
+               "a limit of 4,096 internal steps a communication step with the sanitizers and 16,384 without (its own is 1e9), which a light striker's "
+               "contact (refined far below dt_max) or error-controlled steps (not capped by dt_max) would otherwise "
+               "pass; so no input runs long (`fuzz_replay "
                "-timeout=1` fails one that takes a second of CPU, in every build). CI fuzzes each harness for 30 s "
                "with ASan and UBSan, then 10 s without sanitizers (`scripts/test`, FUZZ_SECONDS = 60); the fuzz "
                "tests fail below 250 inputs per second of CPU with the sanitizers and 1,000 without "
@@ -197,7 +200,9 @@ def write(path, s, v, f, hostile_summary):
     lines += ["", "## Fuzzing the FMI API", "",
               "`tests/fuzz_fmi2.c` reads bytes as a program of FMI calls on two instances (instantiate, set and get "
               "any value reference with raw doubles — NaN, Inf, denormals —, initialization, steps from any time, "
-              "states got, set, serialized and deserialized from mutated or truncated bytes, reset, terminate, free) "
+              "states got, set, serialized and deserialized from mutated or truncated bytes, reset, terminate, free; "
+              "for Model Exchange, its instance, a solver's evaluation (a state moved, the time, derivatives, event "
+              "indicators and nominals required finite) and its modes) "
               "and checks after each call that the status is one the standard allows and that readable outputs "
               "are finite with F >= 0; `tests/fuzz_fmi3.c` does the same for FMI 3.0. Every input that ever broke "
               "them is replayed in every build (`tests/fuzz_regressions/`).", "",

@@ -8,7 +8,10 @@
  * The program: each call takes an opcode byte and then the bytes its
  * arguments need; a value byte picks from a table of interesting numbers or,
  * with its top bit set, reads the next 8 bytes as a raw double (NaN, Inf,
- * denormals and all). Running out of bytes ends the program. */
+ * denormals and all). Running out of bytes ends the program. Both
+ * interfaces: an instance for Model Exchange takes the solver's calls
+ * (states, derivatives, event indicators, nominals, the modes), and the
+ * derivatives, indicators and nominals it gives must be finite. */
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -34,6 +37,19 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
 }
 
 static const fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+
+/* The continuous states and event indicators of modelDescription.xml. */
+enum { STATES = 164, INDICATORS = 2 };
+
+static void require_finite(const fmi2Real *v, size_t n, const char *what)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (!(v[i] - v[i] == 0.0)) {
+            fprintf(stderr, "fuzz invariant broken: a non-finite value among the %s\n", what);
+            abort();
+        }
+}
 
 /* Whether the instance keeps a springpot's full G1 history (damper 2,
  * memory 1), whose steps cost O(N) each. */
@@ -238,6 +254,43 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (checked(fmi2GetBoolean(x, &vr, 1, &b)) == fmi2OK)
                 require(b == fmi2True || b == fmi2False, "a Boolean neither true nor false");
             break;
+        case 23:
+            if (!x)
+                c[k] = fmi2Instantiate(k ? "b" : "a", fmi2ModelExchange, FMU_GUID, "", &callbacks, fmi2False,
+                                       byte(&p) & 1);
+            break;
+        case 24: { /* a solver's evaluation: one state moved, the time set, what it reads */
+            fmi2Real xs[STATES], z[INDICATORS];
+            size_t at = byte(&p) % STATES;
+            r = value(&p);
+            t = value(&p);
+            if (checked(fmi2GetContinuousStates(x, xs, STATES)) == fmi2OK) {
+                xs[at] += r;
+                checked(fmi2SetContinuousStates(x, xs, STATES));
+            }
+            checked(fmi2SetTime(x, t));
+            if (checked(fmi2GetDerivatives(x, xs, STATES)) == fmi2OK)
+                require_finite(xs, STATES, "derivatives");
+            if (checked(fmi2GetEventIndicators(x, z, INDICATORS)) == fmi2OK)
+                require_finite(z, INDICATORS, "event indicators");
+            if (checked(fmi2GetNominalsOfContinuousStates(x, xs, STATES)) == fmi2OK)
+                require_finite(xs, STATES, "nominals");
+            if (x)
+                check_outputs(x);
+            break;
+        }
+        case 25: { /* the modes of Model Exchange */
+            fmi2EventInfo info;
+            switch (byte(&p) % 4) {
+            case 0: checked(fmi2EnterEventMode(x)); break;
+            case 1: checked(fmi2NewDiscreteStates(x, &info)); break;
+            case 2: checked(fmi2EnterContinuousTimeMode(x)); break;
+            default: checked(fmi2CompletedIntegratorStep(x, fmi2True, &b, &b)); break;
+            }
+            if (x)
+                check_outputs(x);
+            break;
+        }
         default:
             checked(fmi2GetDirectionalDerivative(x, &vr, 1, &vr, 1, &r, &t));
             break;

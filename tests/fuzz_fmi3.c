@@ -13,8 +13,11 @@
  * The program: each call takes an opcode byte (its top bit picks the
  * instance) and then the bytes its arguments need; a value byte picks from
  * a table of interesting numbers or, with its top bit set, reads the next 8
- * bytes as a raw double. Running out of bytes ends the program. The seeds,
- * tests/fuzz_corpus/fmi3_*.bin, are written by tests/fuzz_seeds.py. */
+ * bytes as a raw double. Running out of bytes ends the program. Both
+ * interfaces: an instance for Model Exchange takes the solver's calls
+ * (states, time, derivatives, event indicators, nominals, the modes), and
+ * the derivatives, indicators and nominals it gives must be finite. The
+ * seeds, tests/fuzz_corpus/fmi3_*.bin, are written by tests/fuzz_seeds.py. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,7 +49,7 @@ static fmi3Status checked(fmi3Status s)
 typedef struct {
     fmi3Boolean event_mode_used, early_return_allowed;
     double step_start, step_end;
-    int in_step;
+    int in_step, model_exchange;
 } instance_info;
 
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message)
@@ -279,6 +282,56 @@ static void refused(fmi3Instance x, program *p)
     require(checked(s) == fmi3Error, "a call that must be refused was not");
 }
 
+/* -------------------------------------------------------- Model Exchange */
+
+/* The continuous states and event indicators of modelDescription.xml, at most. */
+enum { MAX_STATES = 256, MAX_INDICATORS = 8 };
+
+static void require_finite(const fmi3Float64 *v, size_t n, const char *what)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (!(v[i] - v[i] == 0.0)) {
+            fprintf(stderr, "fuzz invariant broken: a non-finite value among the %s\n", what);
+            abort();
+        }
+}
+
+/* A solver's evaluation: one state moved, the time set, what it reads. */
+static void evaluate(fmi3Instance x, program *p)
+{
+    fmi3Float64 xs[MAX_STATES], z[MAX_INDICATORS];
+    size_t n = 0, m = 0, at = byte(p);
+    const fmi3Float64 dx = value(p), t = value(p);
+    if (checked(fmi3GetNumberOfContinuousStates(x, &n)) != fmi3OK || checked(fmi3GetNumberOfEventIndicators(x, &m))
+        != fmi3OK)
+        return;
+    require(n <= MAX_STATES && m <= MAX_INDICATORS, "more states or event indicators than the harness holds");
+    if (n > 0 && checked(fmi3GetContinuousStates(x, xs, n)) == fmi3OK) {
+        xs[at % n] += dx;
+        checked(fmi3SetContinuousStates(x, xs, n));
+    }
+    checked(fmi3SetTime(x, t));
+    if (checked(fmi3GetContinuousStateDerivatives(x, xs, n)) == fmi3OK)
+        require_finite(xs, n, "derivatives");
+    if (checked(fmi3GetEventIndicators(x, z, m)) == fmi3OK)
+        require_finite(z, m, "event indicators");
+    if (checked(fmi3GetNominalsOfContinuousStates(x, xs, n)) == fmi3OK)
+        require_finite(xs, n, "nominals");
+    check_outputs(x);
+}
+
+/* The modes of Model Exchange beside the event mode (ops 4 and 5). */
+static void me_mode(fmi3Instance x, program *p)
+{
+    fmi3Boolean enter = fmi3False, terminate = fmi3False;
+    if (byte(p) & 1)
+        checked(fmi3EnterContinuousTimeMode(x));
+    else
+        checked(fmi3CompletedIntegratorStep(x, fmi3True, &enter, &terminate));
+    check_outputs(x);
+}
+
 /* ------------------------------------------------------------------ driver */
 
 typedef struct {
@@ -298,6 +351,7 @@ static void instantiate(world *w, int k, program *p)
     const char *token = flags & 0x10 ? "{wrong}" : FMU_GUID;
     if (w->c[k])
         return;
+    info->model_exchange = 0;
     info->event_mode_used = (flags >> 1) & 1;
     info->early_return_allowed = (flags >> 2) & 1;
     info->in_step = 0;
@@ -422,8 +476,8 @@ static void run(world *w, program *p)
             checked(fmi3SetDebugLogging(x, on, byte(p) % 5, categories));
             break;
         }
-        case 21:
-            if (x)
+        case 21: /* the Model Exchange calls among them succeed on an instance for it */
+            if (x && !w->info[k].model_exchange)
                 refused(x, p);
             break;
         case 22:
@@ -432,6 +486,22 @@ static void run(world *w, program *p)
                 require(n >= 1 && n <= 3, "law out of its range");
             if (checked(fmi3GetBoolean(x, &vr, 1, b, 1)) == fmi3OK)
                 require(b[0] == fmi3True || b[0] == fmi3False, "a Boolean neither true nor false");
+            break;
+        case 23:
+            if (!x) {
+                w->info[k].model_exchange = 1;
+                w->c[k] = fmi3InstantiateModelExchange(k ? "b" : "a", FMU_GUID, NULL, fmi3False, byte(p) & 1,
+                                                       &w->info[k], logger);
+                require(w->c[k] != NULL, "Model Exchange's instantiation refused");
+            }
+            break;
+        case 24:
+            if (x)
+                evaluate(x, p);
+            break;
+        case 25:
+            if (x)
+                me_mode(x, p);
             break;
         default:
             checked(fmi3GetDirectionalDerivative(x, &vr, 1, &vr, 1, &r, 1, &t, 1));

@@ -10,10 +10,11 @@ HERE = pathlib.Path(__file__).resolve().parent
 INSTANTIATE, FREE, SETUP, ENTER, EXIT, TERMINATE, RESET, SET_REAL, SET_INT = range(9)
 OUTPUTS, STEP, GET_STATE, SET_STATE, FREE_STATE, SERIALIZE, DESERIALIZE, IN_DER, OUT_DER = range(10, 19)
 LOGGING, STRINGS, STATUSES, GET_INT_BOOL = 19, 20, 21, 22
+INSTANTIATE_ME, ME_EVALUATE, ME_MODE = 23, 24, 25  # Model Exchange: the instance, a solver's evaluation, a mode
 # indices into the harness's tables
-V = {0.0: 0, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
+V = {0.0: 0, 1.0: 2, -1.0: 3, 0.5: 4, 1e-5: 6, 1e-4: 7, 1e-3: 8, 0.626418: 11, 0.7437: 12, 9.81: 20, 1e3: 22}
 REF = {1: 0, 2: 1, 9: 8, 10: 9, 11: 10, 12: 11, 13: 12, 30: 22, 31: 23, 32: 24, 40: 25, 23: 29, 24: 30, 25: 31,
-       26: 32, 33: 33, 34: 34}
+       26: 32, 33: 33, 34: 34, 27: 37, 36: 38, 37: 39, 38: 40, 39: 41}
 
 
 def raw(x):
@@ -46,6 +47,23 @@ SEEDS = {
     "springpot_full_history": start(params=bytes([SET_INT, REF[33], 2, SET_INT, REF[34], 1, SET_REAL, REF[10], V[1e-5]]))
     + steps(20) + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5)
     + bytes([TERMINATE, FREE]),
+    # error-controlled steps (tolerance > 0): ESDIRK 5(4) for the dashpot, Radau IIA for the springpot
+    "dashpot_controlled": start(params=bytes([SET_INT, REF[30], 2, SET_REAL, REF[27], V[1e-5]])) + steps(20)
+    + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(50) + bytes([TERMINATE, FREE]),
+    # a linear spring (the stage's root for n other than 3/2) through the separation, and a driven proxy striker
+    # between two bodies under other forces (the coupling's energy account)
+    "linear_spring_to_separation": start(params=bytes([SET_REAL, REF[23], V[1.0]])) + steps(70) + bytes([OUTPUTS]),
+    "driven_proxy_two_bodies": start(params=bytes([SET_INT, REF[32], 2, SET_REAL, REF[37], V[1e3]]))
+    + bytes([SET_REAL, REF[38], V[9.81]]) + steps(30) + bytes([OUTPUTS, RESET, FREE]),
+    "springpot_controlled": start(params=bytes([SET_INT, REF[30], 2, SET_INT, REF[33], 2, SET_REAL, REF[27],
+                                                V[1e-5]])) + steps(20)
+    + bytes([OUTPUTS, GET_STATE, SERIALIZE, DESERIALIZE, 40, 0, 0, SET_STATE, 0]) + steps(5) + bytes([TERMINATE, FREE]),
+    "two_free_bodies": start(params=bytes([SET_REAL, REF[37], V[0.7437], SET_REAL, REF[36], V[-1.0]])) + steps(20)
+    + bytes([OUTPUTS, RESET, FREE]),
+    # law 2, through the initial event into continuous time, the striker moved into the specimen and out
+    "model_exchange": bytes([INSTANTIATE_ME, 1, SETUP, V[0.0], ENTER, SET_INT, REF[30], 2, EXIT, ME_MODE, 1, ME_MODE, 2])
+    + bytes([ME_EVALUATE, 0, V[1e-4], V[1e-4], ME_MODE, 0, ME_MODE, 1, ME_MODE, 2, ME_MODE, 3, OUTPUTS, GET_STATE])
+    + bytes([ME_EVALUATE, 0]) + raw(-1e-3) + bytes([V[1e-3], ME_MODE, 0, ME_MODE, 1, SET_STATE, 0, TERMINATE, FREE]),
     "out_of_order": bytes([STEP, V[1e-4], 0, EXIT, TERMINATE, INSTANTIATE, 0, STEP, V[1e-4], 0, OUTPUTS, EXIT,
                            GET_STATE, SERIALIZE, TERMINATE, ENTER, SET_INT, REF[30], 7, EXIT, EXIT, STEP, V[1e-4], 0,
                            ENTER, FREE_STATE, 0, FREE, FREE]),
@@ -60,6 +78,7 @@ print(f"wrote {len(SEEDS)} seeds to {HERE / 'fuzz_corpus'}")
 F3_INSTANTIATE, F3_FREE, F3_ENTER, F3_EXIT, F3_EVENT_MODE, F3_UPDATE, F3_STEP_MODE, F3_TERMINATE = range(8)
 F3_RESET, F3_SET_REAL, F3_SET_INT, F3_SET_BOOL, F3_OUTPUTS, F3_STEP, F3_GET_STATE, F3_SET_STATE = range(8, 16)
 F3_FREE_STATE, F3_SERIALIZE, F3_DESERIALIZE, F3_OUT_DER, F3_LOGGING, F3_REFUSED, F3_GET_INT_BOOL = range(16, 23)
+F3_INSTANTIATE_ME, F3_ME_EVALUATE, F3_ME_MODE = 23, 24, 25  # as FMI 2.0's; a mode: 1 continuous time, 0 a step done
 # F3_INSTANTIATE's flags byte
 LOGGING_ON, EVENT_MODE, EARLY_RETURN, CALLBACK = 1, 2, 4, 8
 WRONG_TOKEN, EMPTY_NAME, REQUIRED_VARIABLES = 0x10, 0x20, 0x40
@@ -117,6 +136,15 @@ SEEDS3 = {
                                     + raw(5e-324) + bytes([F3_SET_REAL, REF[1]]) + raw(1e300) + GAP)
     + f3_steps(3, 1e3, events=True) + bytes([F3_STEP, V[1e-5], 1]) + raw(0.5) + bytes([0, F3_OUTPUTS])
     + bytes([F3_STEP, V[1e-5], 1]) + raw(float("nan")) + bytes([0]),
+    "fmi3_springpot_controlled": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[30], 2, F3_SET_INT,
+                                                                                   REF[33], 2, F3_SET_REAL, REF[27],
+                                                                                   V[1e-5]]) + GAP)
+    + f3_steps(20, events=True) + STATE_ROUND_TRIP + f3_steps(5) + bytes([F3_TERMINATE, F3_FREE]),
+    # law 2, through the initial event into continuous time, the striker moved into the specimen and out
+    "fmi3_model_exchange": bytes([F3_INSTANTIATE_ME, 1, F3_ENTER, V[0.0], 0, V[0.0], F3_SET_INT, REF[30], 2, F3_EXIT,
+                                  F3_UPDATE, F3_ME_MODE, 1, F3_ME_EVALUATE, 0, V[1e-4], V[1e-4], F3_ME_MODE, 0,
+                                  F3_EVENT_MODE, F3_UPDATE, F3_ME_MODE, 1, F3_OUTPUTS, F3_GET_STATE, F3_ME_EVALUATE, 0])
+    + raw(-1e-3) + bytes([V[1e-3], F3_ME_MODE, 0, F3_EVENT_MODE, F3_UPDATE, F3_SET_STATE, 0, F3_TERMINATE, F3_FREE]),
     "fmi3_springpot_full_history": f3_start(EVENT_MODE | EARLY_RETURN, params=bytes([F3_SET_INT, REF[33], 2, F3_SET_INT,
                                                                                      REF[34], 1, F3_SET_REAL, REF[10],
                                                                                      V[1e-5]]) + GAP)

@@ -46,11 +46,11 @@ NAMED = {"g1-history": "memory = 1 (the full G1 history) is invalid"}
 class Instance:
     """The contact FMU of one FMI version through fmpy, by name, its error messages collected."""
 
-    def __init__(self, fmi, **values):
+    def __init__(self, fmi, start_time=0.0, **values):
         from fmpy import extract, read_model_description
         path = str(FMU if fmi == 2 else FMU3)
         md = read_model_description(path)
-        self.fmi, self.values = fmi, values
+        self.fmi, self.values, self.start_time = fmi, values, start_time
         self.vars = {v.name: v for v in md.modelVariables}
         self.errors = []
         folder = extract(path)
@@ -76,10 +76,10 @@ class Instance:
 
     def start(self, **values):
         if self.fmi == 2:
-            self.fmu.setupExperiment(startTime=0.0)
+            self.fmu.setupExperiment(startTime=self.start_time)
             self.fmu.enterInitializationMode()
         else:
-            self.fmu.enterInitializationMode(startTime=0.0)
+            self.fmu.enterInitializationMode(startTime=self.start_time)
         for name, value in values.items():
             vr = [self.vars[name].valueReference]
             if self.vars[name].type in ("Real", "Float64"):

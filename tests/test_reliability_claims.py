@@ -91,12 +91,17 @@ def test_the_memory_per_configuration_is_what_an_instance_allocates():
 
 
 def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
-    """The budget of an input as the harnesses define it, the seconds and
+    """The budget of an input as the harnesses define it, the FMU's step limit
+    in the fuzzers and its own, the seconds and
     the floors of the fuzz tests as CMake and scripts/test set them, and the
     count CI runs at least, which follows from them."""
-    steps, terms, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
+    steps, terms, sanitized_limit, plain_limit, own, timeout, sanitized, plain, sanitized_floor, plain_floor, at_least = claim(
         r"Each input's work is bounded \(`tests/fuzz_program.h`\): at most ([\d,]+) internal steps in all its steps "
-        r"and ([\d,]+) terms of a full G1 history's sums, so that no input runs long \(`fuzz_replay -timeout=(\d+)` "
+        r"of dt_max and ([\d,]+) terms of a full G1 history's sums, and the fuzzers build the FMU with a limit of "
+        r"([\d,]+) internal steps a communication step with the sanitizers and ([\d,]+) without \(its own is (\S+)\), "
+        r"which a light striker's contact "
+        r"\(refined far below dt_max\) or error-controlled steps \(not capped by dt_max\) would otherwise pass; so no "
+        r"input runs long \(`fuzz_replay -timeout=(\d+)` "
         r"fails one that takes a second of CPU, in every build\)\. CI fuzzes each harness for (\d+) s with ASan and "
         r"UBSan, then (\d+) s without sanitizers \(`scripts/test`, FUZZ_SECONDS = 60\); the fuzz tests fail below "
         r"([\d,]+) inputs per second of CPU with the sanitizers and ([\d,]+) without \(`tests/fuzz_rate.py`, which "
@@ -107,6 +112,11 @@ def test_the_fuzzing_ci_runs_is_what_the_harnesses_and_the_fuzz_tests_allow():
     assert float(re.search(r"#define BUDGET_TERMS ([\d.]+)", program).group(1)) == n(terms)
     cmake = (ROOT / "CMakeLists.txt").read_text()
     fuzzer = cmake[cmake.index("function(add_fmi_fuzzer"):cmake.index("endfunction()", cmake.index("function(add_fmi_fuzzer"))]
+    limits = [sanitized_limit.replace(",", ""), plain_limit.replace(",", "")]
+    assert re.findall(r"set\(max_steps (\d+)\)", fuzzer) == limits
+    assert "MAX_STEPS=${max_steps}" in fuzzer
+    glue = (ROOT / "fmu_src" / "binding" / "fmu_model.c").read_text()
+    assert float(re.search(r"#define MAX_STEPS (\d+)", glue).group(1)) == float(own)
     assert re.findall(r"set\(floor (\d+)\)", fuzzer) == [sanitized_floor.replace(",", ""), plain_floor.replace(",", "")]
     assert f"-timeout={timeout}" in fuzzer
     assert re.findall(r"fuzz_replay(?:_fmi3)? -timeout=(\d+)", cmake) == [timeout, timeout]

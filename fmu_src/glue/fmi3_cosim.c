@@ -41,6 +41,7 @@ typedef struct {
     fmi3IntermediateUpdateCallback intermediate_update;
     int event_mode_used;
     int early_return_allowed;
+    fi_state *step_start; /* before a step that goes on after an event inside it (fmi3DoStep) */
 } instance;
 
 static void send_log(const fmu_instance *base, fi_status status, const char *category, const char *message)
@@ -100,6 +101,7 @@ static instance *instantiate(const char *name, fmi3String instanceName, fmi3Stri
         return NULL;
     }
     *in = probe;
+    in->step_start = NULL;
     in->intermediate_update = intermediateUpdate;
     in->event_mode_used = eventModeUsed;
     in->early_return_allowed = earlyReturnAllowed;
@@ -201,6 +203,7 @@ void fmi3FreeInstance(fmi3Instance c)
     if (!in)
         return;
     fi_release(&in->base);
+    fi_free_state(&in->step_start);
     free(in);
 }
 
@@ -543,10 +546,19 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     *lastSuccessfulTime = t;
     if (fi_check_step(&in->base, t, communicationStepSize, 0, "fmi3DoStep") != FI_OK)
         return fmi3Error;
+    /* A step that goes on after an event inside it keeps its start: a
+     * refusal of the rest takes the whole step back, as a refused step
+     * changes nothing. */
+    if (in->intermediate_update && !in->early_return_allowed
+        && fi_get_state(&in->base, &in->step_start, "fmi3DoStep") != FI_OK)
+        return fmi3Error;
     for (;;) {
         if (fm_do_step_until(in->base.fm, now, options & FM_CONTINUE ? end - now : fi_advance(t, communicationStepSize),
-                             options, &event) != FM_OK)
+                             options, &event) != FM_OK) {
+            if (options & FM_CONTINUE)
+                fi_set_state(&in->base, in->step_start, STEP_MODE, "fmi3DoStep");
             return fmi3Error;
+        }
         now = fm_time(in->base.fm);
         *lastSuccessfulTime = now;
         if (!event)
