@@ -201,6 +201,56 @@ class Instance:
     def get(self, name):
         return self.fmu.getReal([self.vr[name]])[0]
 
+    def set(self, name, value):
+        self.fmu.setReal([self.vr[name]], [value])
+
+    def get_boolean(self, name):
+        return self.fmu.getBoolean([self.vr[name]])[0]
+
+
+class Instance3(Instance):
+    """The same as an FMU3Model of the FMI 3.0 FMU (FMU3)."""
+
+    def __init__(self, model_description, unzipped, **values):
+        from fmpy.fmi3 import FMU3Model
+        self.vr = {v.name: v.valueReference for v in model_description.modelVariables}
+        self.log = []
+        self.fmu = FMU3Model(guid=model_description.guid, unzipDirectory=unzipped,
+                             modelIdentifier=model_description.modelExchange.modelIdentifier, instanceName="me3")
+        self.fmu.instantiate(logMessage=lambda env, status, category, message: self.log.append(message.decode()))
+        self.fmu.enterInitializationMode()
+        for name, value in values.items():
+            (self.fmu.setInt32 if isinstance(value, int) else self.fmu.setFloat64)([self.vr[name]], [value])
+
+    def start(self):
+        self.fmu.exitInitializationMode()
+        self.fmu.updateDiscreteStates()
+        self.fmu.enterContinuousTimeMode()
+        return self
+
+    def set_states(self, x, nx=STATES):
+        self.fmu.setContinuousStates(np.ascontiguousarray(x).ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+
+    def get(self, name):
+        return self.fmu.getFloat64([self.vr[name]])[0]
+
+    def set(self, name, value):
+        self.fmu.setFloat64([self.vr[name]], [value])
+
+
+@pytest.fixture
+def instance3():
+    from fmpy import extract, read_model_description
+    md, folder, made = read_model_description(str(FMU3)), extract(str(FMU3)), []
+
+    def make(**values):
+        made.append(Instance3(md, folder, **values))
+        return made[-1]
+
+    yield make
+    for i in made:
+        i.fmu.freeInstance()
+
 
 @pytest.fixture
 def instance(model_description, unzipped):
@@ -476,7 +526,7 @@ def out_of_contact(shift):
 
 
 def output_values(i, outputs):
-    return np.array([float(i.fmu.getBoolean([i.vr[n]])[0]) if n == "contact" else i.get(n) for n in outputs])
+    return np.array([float(i.get_boolean(n)) if n == "contact" else i.get(n) for n in outputs])
 
 
 def output_slopes(i, x, knowns, outputs):
@@ -486,20 +536,19 @@ def output_slopes(i, x, knowns, outputs):
     at = output_values(i, outputs)
     columns, steps = [], []
     for known in knowns:
-        vr = i.vr[known] if isinstance(known, str) else i.vr[STATE_NAMES[known]]
         value = i.get(known) if isinstance(known, str) else x[known]
         h = 1e-4 * max(abs(value), 0.1 if isinstance(known, str) else 1e-7)
         sides = []
         for sign in (1, -1):
             y = x.copy()
             if isinstance(known, str):
-                i.fmu.setReal([vr], [value + sign * h])
+                i.set(known, value + sign * h)
             else:
                 y[known] += sign * h
             i.set_states(y)
             sides.append(output_values(i, outputs))
         if isinstance(known, str):
-            i.fmu.setReal([vr], [value])
+            i.set(known, value)
         i.set_states(x)
         columns.append(sides[0] - sides[1])
         steps.append(2 * h)
@@ -513,24 +562,26 @@ def output_slopes(i, x, knowns, outputs):
 UNDECLARED_FEEDTHROUGH = {("v_striker", "v"), ("v_striker", "v2")}
 
 
-def test_the_outputs_declared_dependencies_are_the_perturbations_pattern(instance, model_description):
-    """The Outputs' dependencies (FMI 2.0's dependencies="" on main: co-simulation's no feedthrough)
-    against what moving each state and the inputs v and v2 does to each output: over the four scenes,
-    at states in contact and out of it, an output that moves with a known declares it, and every
-    declared one moves in a scene (but UNDECLARED_FEEDTHROUGH). An output moves when its central
-    difference exceeds 1e-10 of its value: the outputs that follow a known move by 2e-4 or more of
-    their value at these steps (h = 1e-4 of the known, slopes of order 1 in relative terms), those that
-    do not by a rounding of x1 + x2 (1e-16). A dependency declared constant has the slope 1, to the
-    rounding of x1 + x2 over h (1e-12); each declared dependent changes its slope between the states.
-    The FMI 3.0 FMU declares the same, by name."""
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_the_outputs_declared_dependencies_are_the_perturbations_pattern(instance, instance3, model_description, fmi):
+    """The Outputs' dependencies (once FMI 2.0's dependencies="", co-simulation's no feedthrough, and
+    FMI 3.0's none, every known) against what moving each state and the inputs v and v2 does to each
+    output, in an instance of each FMU: over the four scenes, at states in contact and out of it, an
+    output that moves with a known declares it, and every declared one moves in a scene (but
+    UNDECLARED_FEEDTHROUGH). An output moves when its central difference exceeds 1e-10 of its value:
+    the outputs that follow a known move by 2e-4 or more of their value at these steps (h = 1e-4 of
+    the known, slopes of order 1 in relative terms), those that do not by a rounding of x1 + x2
+    (1e-16). A dependency declared constant has the slope 1, to the rounding of x1 + x2 over h
+    (1e-12); each declared dependent changes its slope between the states. Both FMUs declare the
+    same, by name."""
     from fmpy import read_model_description
-    declared = declared_output_dependencies(model_description)
+    declared = declared_output_dependencies(model_description if fmi == 2 else read_model_description(str(FMU3)))
     outputs = list(declared)
     knowns = list(range(STATES)) + ["v", "v2"]
     names = STATE_NAMES + ["v", "v2"]
     seen, slopes = set(), {}
     for values in SCENES:
-        i = instance(**values).start()
+        i = (instance if fmi == 2 else instance3)(**values).start()
         for x in (in_contact(0.0), in_contact(1e-5), out_of_contact(0.0), out_of_contact(1e-5)):
             i.set_states(x)
             at, change, slope = output_slopes(i, x, knowns, outputs)
@@ -538,7 +589,9 @@ def test_the_outputs_declared_dependencies_are_the_perturbations_pattern(instanc
             for r, c in zip(*np.nonzero(moves)):
                 seen.add((outputs[r], names[c]))
                 slopes.setdefault((outputs[r], names[c]), set()).add(slope[r, c])
-    pairs = {(o, k): kind for o, knowns_of in declared.items() for k, kind in knowns_of.items()}
+    every = dict.fromkeys(names, "dependent")  # what an output that declares none depends on
+    pairs = {(o, k): kind for o, knowns_of in declared.items()
+             for k, kind in (every if knowns_of is None else knowns_of).items()}
     assert set(pairs) | UNDECLARED_FEEDTHROUGH == seen
     assert not set(pairs) & UNDECLARED_FEEDTHROUGH
     for pair, kind in pairs.items():
@@ -546,7 +599,8 @@ def test_the_outputs_declared_dependencies_are_the_perturbations_pattern(instanc
             assert max(abs(s - 1.0) for s in slopes[pair]) <= 1e-12, pair
         else:
             assert kind == "dependent" and len(slopes[pair]) > 1, pair
-    assert declared_output_dependencies(read_model_description(str(FMU3))) == declared
+    assert declared_output_dependencies(read_model_description(str(FMU3))) == \
+        declared_output_dependencies(model_description)
 
 
 def test_a_state_the_host_set_restores_in_a_new_instance(instance):
