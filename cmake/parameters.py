@@ -48,8 +48,8 @@ RATE_DEPENDENCIES = {
 # What each output depends on among the knowns of continuous-time and event mode, the inputs and
 # the states (fmu_model.c's real_output on model/rates.c's contact_me_set_states): F = K x1^n and
 # semi_integral, a multiple of F, of x1 = x - x2 (0 out of contact, where x1 is 0 too); the states
-# x, x2, v_striker and E_diss are outputs of their own values. F_avg, F_avg_next and eps change only
-# in the co-simulation's steps or at events, F_peak and contact at events and completed integrator
+# x, x2, v_striker and E_diss are outputs of their own values. F_avg and F_avg_next change only in
+# the co-simulation's steps, eps and contact at events, F_peak at events and completed integrator
 # steps. The driven scene's v_striker is v - v2 in Model Exchange, but the one ModelStructure also
 # makes co-simulation's promise of no direct feedthrough from the inputs (docs/model_exchange.md).
 OUTPUT_DEPENDENCIES = {
