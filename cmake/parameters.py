@@ -48,7 +48,8 @@ RATE_DEPENDENCIES = {
 # What each output depends on among the knowns of continuous-time and event mode, the inputs and
 # the states (fmu_model.c's real_output on model/rates.c's contact_me_set_states): F = K x1^n and
 # semi_integral, a multiple of F, of x1 = x - x2 (0 out of contact, where x1 is 0 too); the states
-# x, x2, v_striker and E_diss are outputs of their own values. F_avg and F_avg_next change only in
+# x, x2, v_striker and E_diss are outputs of their own values (the driven scene's v_striker not: a
+# factor 1 or 0 that the scene fixes). F_avg and F_avg_next change only in
 # the co-simulation's steps, eps and contact at events, F_peak at events and completed integrator
 # steps. The driven scene's v_striker is v - v2 in Model Exchange, but the one ModelStructure also
 # makes co-simulation's promise of no direct feedthrough from the inputs (docs/model_exchange.md).
@@ -57,7 +58,7 @@ OUTPUT_DEPENDENCIES = {
     "x": {"x": "constant"},
     "x1": {"x": "dependent", "x2": "dependent"},
     "x2": {"x2": "constant"},
-    "v_striker": {"v_striker": "constant"},
+    "v_striker": {"v_striker": "fixed"},
     "E_diss": {"E_diss": "constant"},
     "semi_integral": {"x": "dependent", "x2": "dependent"},
 }

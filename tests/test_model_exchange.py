@@ -571,34 +571,40 @@ def test_the_outputs_declared_dependencies_are_the_perturbations_pattern(instanc
     UNDECLARED_FEEDTHROUGH). An output moves when its central difference exceeds 1e-10 of its value:
     the outputs that follow a known move by 2e-4 or more of their value at these steps (h = 1e-4 of
     the known, slopes of order 1 in relative terms), those that do not by a rounding of x1 + x2
-    (1e-16). A dependency declared constant has the slope 1, to the rounding of x1 + x2 over h
-    (1e-12); each declared dependent changes its slope between the states. Both FMUs declare the
-    same, by name."""
+    (1e-16). A dependency declared constant has the slope 1 at every state of every scene, to the
+    rounding of x1 + x2 over h (1e-12); a fixed one keeps its slope from state to state within a
+    scene (to that rounding; exactly in one); each declared dependent changes its slope between the
+    states of a scene by more than 1e-6 of it (far above that rounding, far below the slopes'
+    changes: x1's 1 to 0 out of contact, F's with x1^(1/2)). Both FMUs declare the same, by name."""
     from fmpy import read_model_description
     declared = declared_output_dependencies(model_description if fmi == 2 else read_model_description(str(FMU3)))
     outputs = list(declared)
     knowns = list(range(STATES)) + ["v", "v2"]
     names = STATE_NAMES + ["v", "v2"]
-    seen, slopes = set(), {}
+    seen, slopes = set(), []  # slopes: per scene, [output, known, state]
     for values in SCENES:
         i = (instance if fmi == 2 else instance3)(**values).start()
+        found = []
         for x in (in_contact(0.0), in_contact(1e-5), out_of_contact(0.0), out_of_contact(1e-5)):
             i.set_states(x)
             at, change, slope = output_slopes(i, x, knowns, outputs)
             moves = np.abs(change) > 1e-10 * np.abs(at)[:, None]
-            for r, c in zip(*np.nonzero(moves)):
-                seen.add((outputs[r], names[c]))
-                slopes.setdefault((outputs[r], names[c]), set()).add(slope[r, c])
+            seen |= {(outputs[r], names[c]) for r, c in zip(*np.nonzero(moves))}
+            found.append(slope)
+        slopes.append(np.stack(found, axis=-1))
     every = dict.fromkeys(names, "dependent")  # what an output that declares none depends on
     pairs = {(o, k): kind for o, knowns_of in declared.items()
              for k, kind in (every if knowns_of is None else knowns_of).items()}
     assert set(pairs) | UNDECLARED_FEEDTHROUGH == seen
     assert not set(pairs) & UNDECLARED_FEEDTHROUGH
-    for pair, kind in pairs.items():
+    for (output, known), kind in pairs.items():
+        of = [scene[outputs.index(output), names.index(known)] for scene in slopes]  # per scene, per state
         if kind == "constant":
-            assert max(abs(s - 1.0) for s in slopes[pair]) <= 1e-12, pair
+            assert max(np.max(np.abs(s - 1.0)) for s in of) <= 1e-12, (output, known)
+        elif kind == "fixed":
+            assert max(np.ptp(s) for s in of) <= 1e-12 and min(np.ptp(s) for s in of) == 0.0, (output, known)
         else:
-            assert kind == "dependent" and len(slopes[pair]) > 1, pair
+            assert kind == "dependent" and max(np.ptp(s) - 1e-6 * np.max(np.abs(s)) for s in of) > 0, (output, known)
     assert declared_output_dependencies(read_model_description(str(FMU3))) == \
         declared_output_dependencies(model_description)
 
