@@ -45,6 +45,23 @@ RATE_DEPENDENCIES = {
     "E_diss": {"x": "dependent", "x2": "dependent", "phi": "dependent"},
     "phi": {"x": "dependent", "x2": "dependent", "phi": "fixed"},
 }
+# What each output depends on among the knowns of continuous-time and event mode, the inputs and
+# the states (fmu_model.c's real_output on model/rates.c's contact_me_set_states): F = K x1^n and
+# semi_integral, a multiple of F, of x1 = x - x2 (0 out of contact, where x1 is 0 too); the states
+# x, x2, v_striker and E_diss are outputs of their own values (the driven scene's v_striker not: a
+# factor 1 or 0 that the scene fixes). F_avg and F_avg_next change only in
+# the co-simulation's steps, eps and contact at events, F_peak at events and completed integrator
+# steps. The driven scene's v_striker is v - v2 in Model Exchange, but the one ModelStructure also
+# makes co-simulation's promise of no direct feedthrough from the inputs (docs/model_exchange.md).
+OUTPUT_DEPENDENCIES = {
+    "F": {"x": "dependent", "x2": "dependent"},
+    "x": {"x": "constant"},
+    "x1": {"x": "dependent", "x2": "dependent"},
+    "x2": {"x2": "constant"},
+    "v_striker": {"v_striker": "fixed"},
+    "E_diss": {"E_diss": "constant"},
+    "semi_integral": {"x": "dependent", "x2": "dependent"},
+}
 ARGUMENT = re.compile(r'\s*((?:"[^"\\]*"\s*)+|[^,"]*?)\s*(,|$)')
 
 
@@ -164,17 +181,30 @@ def exchange_dependencies(variable, by_name, key):
     return " ".join(by_name[d][key] for d in EXCHANGE_DEPENDENCIES.get(variable["name"], ()))
 
 
-def rate_dependencies(variable, fmu, variables, key):
-    """The dependencies and dependenciesKind attributes of the derivative `variable`: its
-    RATE_DEPENDENCIES as FMI 2.0 indices or FMI 3.0 value references (key), in ascending order."""
-    state = re.sub(r"\[\d+\]$", "", variable["derivative"])
+def known_dependencies(table, fmu, variables, key):
+    """The dependencies and dependenciesKind attributes of the knowns `table` (name: kind, as in
+    RATE_DEPENDENCIES) as FMI 2.0 indices or FMI 3.0 value references (key), in ascending order;
+    dependencies="" alone for none."""
     known = {r["name"]: [r[key]] for r in fmu}
     for v in variables:
         if not v["derivative"] and not v.get("indicator"):
             known.setdefault(re.sub(r"\[\d+\]$", "", v["name"]), []).append(v[key])
-    pairs = sorted((int(ref), kind) for name, kind in RATE_DEPENDENCIES[state].items() for ref in known[name])
+    pairs = sorted((int(ref), kind) for name, kind in table.items() for ref in known[name])
+    if not pairs:
+        return ' dependencies=""'
     return (f' dependencies="{" ".join(str(ref) for ref, _ in pairs)}"'
             f' dependenciesKind="{" ".join(kind for _, kind in pairs)}"')
+
+
+def rate_dependencies(variable, fmu, variables, key):
+    """The dependencies of the derivative `variable`: its state's RATE_DEPENDENCIES."""
+    return known_dependencies(RATE_DEPENDENCIES[re.sub(r"\[\d+\]$", "", variable["derivative"])], fmu, variables,
+                              key)
+
+
+def output_dependencies(row, fmu, variables, key):
+    """The dependencies of the output `row`: its OUTPUT_DEPENDENCIES."""
+    return known_dependencies(OUTPUT_DEPENDENCIES.get(row["name"], {}), fmu, variables, key)
 
 
 def fmi2_section(rows):
@@ -187,8 +217,9 @@ def fmi2_section(rows):
     lines = ["  <ModelVariables>"] + [fmi2_variable(r) for r in fmu]
     lines += [fmi2_exchange_variable(v, fmu, exchange) for v in exchange]
     lines += ["  </ModelVariables>", "", "  <ModelStructure>", "    <Outputs>",
-              "      <!-- outputs change only in fmi2DoStep: no direct feedthrough from the inputs -->"]
-    lines += [f'      <Unknown index="{r["index"]}" dependencies=""/>' for r in outputs]
+              "      <!-- no direct feedthrough from the inputs; in Model Exchange some outputs depend on "
+              "the states (docs/model_exchange.md) -->"]
+    lines += [f'      <Unknown index="{r["index"]}"{output_dependencies(r, fmu, exchange, "index")}/>' for r in outputs]
     lines += ["    </Outputs>"]
     if derivatives:
         lines += ["    <Derivatives>", "      <!-- Model Exchange's states' rates (docs/model_exchange.md); at the "
@@ -237,9 +268,9 @@ def fmi3_section(rows):
              '      description="simulation time"/>']
     lines += [fmi3_variable(r) for r in fmu] + [fmi3_exchange_variable(v, fmu, exchange) for v in exchange]
     lines += ["  </ModelVariables>", "", "  <ModelStructure>",
-              "    <!-- outputs change only in fmi3DoStep (and the discrete ones in event",
-              "         mode): no direct feedthrough from the inputs -->"]
-    lines += [f'    <Output valueReference="{r["vr"]}"/>' for r in outputs]
+              "    <!-- no direct feedthrough from the inputs; in Model Exchange some outputs",
+              "         depend on the states (docs/model_exchange.md) -->"]
+    lines += [f'    <Output valueReference="{r["vr"]}"{output_dependencies(r, fmu, exchange, "vr")}/>' for r in outputs]
     if derivatives:
         lines += ["    <!-- Model Exchange's states' rates (docs/model_exchange.md) -->"]
         lines += [f'    <ContinuousStateDerivative valueReference="{v["vr"]}"'

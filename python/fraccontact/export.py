@@ -271,6 +271,14 @@ def renumbered(text, numbers):
     return " ".join(numbers[n] for n in text.split() if n in numbers)
 
 
+def output_knowns(root, fmi):
+    """What an output may depend on in the kept variables (renumbered): the inputs and the states, those a
+    derivative names; a co-simulation export has no states (its x, x2, ... are outputs only)."""
+    states = {typed.get("derivative") for typed in root.iter() if typed.get("derivative") is not None}
+    return states | {str(i) if fmi == 2 else v.vr for i, v in enumerate(variables_of(root, fmi), 1)
+                     if v.causality == "input"}
+
+
 def filter_structure(root, numbers, fmi):
     """ModelStructure and derivative references of the variables kept, renumbered (FMI 2.0: 1-based
     indices into ModelVariables; FMI 3.0: value references, which stay)."""
@@ -283,6 +291,7 @@ def filter_structure(root, numbers, fmi):
             else:
                 del typed.attrib["derivative"]
     structure = root.find("ModelStructure")
+    knowns = output_knowns(root, fmi)
     for holder in [structure] + list(structure):
         for unknown in list(holder):
             if unknown.get(key) is None:
@@ -294,10 +303,13 @@ def filter_structure(root, numbers, fmi):
             kinds = unknown.get("dependenciesKind")
             if unknown.get("dependencies") is not None:
                 deps = unknown.get("dependencies").split()
-                kept = [i for i, d in enumerate(deps) if d in numbers]
+                output = holder.tag == "Outputs" or unknown.tag == "Output"
+                kept = [i for i, d in enumerate(deps) if d in numbers and (not output or numbers[d] in knowns)]
                 unknown.set("dependencies", " ".join(numbers[deps[i]] for i in kept))
-                if kinds is not None:
+                if kinds is not None and kept:
                     unknown.set("dependenciesKind", " ".join(kinds.split()[i] for i in kept))
+                elif kinds is not None:
+                    del unknown.attrib["dependenciesKind"]
         if holder is not structure and len(holder) == 0 and fmi == 2:
             structure.remove(holder)
 
