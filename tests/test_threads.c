@@ -100,6 +100,16 @@ static struct {
     fmi3ExitInitializationModeTYPE *exit;
     fmi3DoStepTYPE *step;
     fmi3FreeInstanceTYPE *free;
+    /* Model Exchange */
+    fmi3InstantiateModelExchangeTYPE *instantiate_me;
+    fmi3UpdateDiscreteStatesTYPE *update_discrete_states;
+    fmi3EnterContinuousTimeModeTYPE *enter_continuous;
+    fmi3EnterEventModeTYPE *enter_event;
+    fmi3SetTimeTYPE *set_time;
+    fmi3GetContinuousStatesTYPE *get_states;
+    fmi3SetContinuousStatesTYPE *set_states;
+    fmi3GetContinuousStateDerivativesTYPE *get_derivatives;
+    fmi3GetEventIndicatorsTYPE *get_indicators;
 } fmi3;
 
 static struct {
@@ -145,6 +155,15 @@ static void load(const char *fmi2_path, const char *fmi3_path, const char *libra
     *(void **)&fmi3.exit = symbol(b, "fmi3ExitInitializationMode");
     *(void **)&fmi3.step = symbol(b, "fmi3DoStep");
     *(void **)&fmi3.free = symbol(b, "fmi3FreeInstance");
+    *(void **)&fmi3.instantiate_me = symbol(b, "fmi3InstantiateModelExchange");
+    *(void **)&fmi3.update_discrete_states = symbol(b, "fmi3UpdateDiscreteStates");
+    *(void **)&fmi3.enter_continuous = symbol(b, "fmi3EnterContinuousTimeMode");
+    *(void **)&fmi3.enter_event = symbol(b, "fmi3EnterEventMode");
+    *(void **)&fmi3.set_time = symbol(b, "fmi3SetTime");
+    *(void **)&fmi3.get_states = symbol(b, "fmi3GetContinuousStates");
+    *(void **)&fmi3.set_states = symbol(b, "fmi3SetContinuousStates");
+    *(void **)&fmi3.get_derivatives = symbol(b, "fmi3GetContinuousStateDerivatives");
+    *(void **)&fmi3.get_indicators = symbol(b, "fmi3GetEventIndicators");
     *(void **)&library.params_default = symbol(c, "fc_params_default");
     *(void **)&library.run_batch = symbol(c, "fc_run_batch");
 }
@@ -261,6 +280,61 @@ static void run_fmi3(run *r)
         fmi3.free(x);
 }
 
+/* Model Exchange through FMI 3.0, as me_step and run_fmi2_me do through 2.0. */
+static int update_discrete_states3(fmi3Instance x)
+{
+    fmi3Boolean again = fmi3True, terminate, nominals, values, next_defined;
+    fmi3Float64 next;
+    int rounds;
+    for (rounds = 0; again && rounds < 10; rounds++)
+        if (fmi3.update_discrete_states(x, &again, &terminate, &nominals, &values, &next_defined, &next) != fmi3OK)
+            return -1;
+    return again ? -1 : 0;
+}
+
+static int me_step3(fmi3Instance x, double t, double *states, double *z)
+{
+    double rates[ME_STATES], next[ME_INDICATORS];
+    int i, event = 0;
+    if (fmi3.get_derivatives(x, rates, ME_STATES) != fmi3OK)
+        return -1;
+    for (i = 0; i < ME_STATES; i++)
+        states[i] += H / ME_STEPS * rates[i];
+    if (fmi3.set_time(x, t) != fmi3OK || fmi3.set_states(x, states, ME_STATES) != fmi3OK
+        || fmi3.get_indicators(x, next, ME_INDICATORS) != fmi3OK)
+        return -1;
+    for (i = 0; i < ME_INDICATORS; i++)
+        event |= (next[i] > 0.0) != (z[i] > 0.0);
+    if (event && (fmi3.enter_event(x) != fmi3OK || update_discrete_states3(x) != 0
+                  || fmi3.enter_continuous(x) != fmi3OK || fmi3.get_indicators(x, next, ME_INDICATORS) != fmi3OK))
+        return -1;
+    memcpy(z, next, sizeof next);
+    return 0;
+}
+
+static void run_fmi3_me(run *r)
+{
+    const configuration *c = &configurations[r->config];
+    const fmi3Int32 integer[3] = {c->law, c->damper, c->memory};
+    fmi3Float64 real[3];
+    const fmi3ValueReference *real_vr = real_parameters(r, real);
+    fmi3Instance x = fmi3.instantiate_me("threads", FMU_GUID, NULL, fmi3False, fmi3False, NULL, logger3);
+    double states[ME_STATES], z[ME_INDICATORS];
+    int i, j;
+    r->failed = !x || fmi3.set_int32(x, integer_vr, 3, integer, 3) != fmi3OK
+                || fmi3.set_float64(x, real_vr, 3, real, 3) != fmi3OK
+                || fmi3.enter(x, fmi3False, 0.0, 0.0, fmi3False, 0.0) != fmi3OK || fmi3.exit(x) != fmi3OK
+                || update_discrete_states3(x) != 0 || fmi3.enter_continuous(x) != fmi3OK
+                || fmi3.get_states(x, states, ME_STATES) != fmi3OK || fmi3.get_indicators(x, z, ME_INDICATORS) != fmi3OK;
+    for (i = 0; i < STEPS && !r->failed; i++) {
+        for (j = 1; j <= ME_STEPS && !r->failed; j++)
+            r->failed = me_step3(x, i * H + j * (H / ME_STEPS), states, z) != 0;
+        r->failed = r->failed || fmi3.get_float64(x, output_vr, OUTPUTS, r->outputs[i], OUTPUTS) != fmi3OK;
+    }
+    if (x)
+        fmi3.free(x);
+}
+
 static void run_batch(run *r)
 {
     fc_params p[BATCH];
@@ -289,14 +363,16 @@ static void perform(run *r)
         run_fmi2_me(r);
     else if (r->fmi == 3)
         run_fmi3(r);
+    else if (r->fmi == 5)
+        run_fmi3_me(r);
     else
         run_batch(r);
 }
 
 /* Every FMU configuration in both versions, batches, and Model Exchange
- * (fmi = 4) of the two configurations from ME_FIRST on, in two variants:
- * RUNS runs, shared out among the threads. */
-enum { ME_FIRST = 1, ME_CONFIGURATIONS = 2, PER_VARIANT = 2 * CONFIGURATIONS + 1 + ME_CONFIGURATIONS,
+ * (fmi = 4: FMI 2.0, 5: FMI 3.0) of the two configurations from ME_FIRST
+ * on, in two variants: RUNS runs, shared out among the threads. */
+enum { ME_FIRST = 1, ME_CONFIGURATIONS = 2, PER_VARIANT = 2 * CONFIGURATIONS + 1 + 2 * ME_CONFIGURATIONS,
        RUNS = 2 * PER_VARIANT };
 static run alone[RUNS], threaded[RUNS];
 
@@ -305,8 +381,9 @@ static void describe(run *r, int k)
     r->variant = k / PER_VARIANT;
     k %= PER_VARIANT;
     if (k > 2 * CONFIGURATIONS) {
-        r->fmi = 4;
-        r->config = ME_FIRST + k - 2 * CONFIGURATIONS - 1;
+        k -= 2 * CONFIGURATIONS + 1;
+        r->fmi = 4 + k / ME_CONFIGURATIONS;
+        r->config = ME_FIRST + k % ME_CONFIGURATIONS;
         return;
     }
     r->fmi = k == 2 * CONFIGURATIONS ? 0 : 2 + k / CONFIGURATIONS;
@@ -342,14 +419,17 @@ int main(int argc, char **argv)
         pthread_join(threads[k], NULL);
     for (k = 0; k < RUNS; k++) {
         const run *a = &alone[k], *t = &threaded[k];
-        const char *via = a->fmi == 2 ? "FMI 2.0" : a->fmi == 3 ? "FMI 3.0" : a->fmi == 4 ? "FMI 2.0 Model Exchange"
-                                                                                        : "the library",
+        const char *via = a->fmi == 2   ? "FMI 2.0"
+                          : a->fmi == 3 ? "FMI 3.0"
+                          : a->fmi == 4 ? "FMI 2.0 Model Exchange"
+                          : a->fmi == 5 ? "FMI 3.0 Model Exchange"
+                                        : "the library",
                    *what = a->fmi ? configurations[a->config].name : "a batch of every configuration";
         CHECK(!a->failed && !t->failed, "%s, %s, variant %d: a run failed", via, what, a->variant);
         CHECK(memcmp(a->outputs, t->outputs, sizeof a->outputs) == 0
                   && memcmp(a->outcomes, t->outcomes, sizeof a->outcomes) == 0,
               "%s, %s, variant %d: in a thread, results not those of the run alone", via, what, a->variant);
-        if (a->fmi == 4) { /* the impact ended, eps within Euler's first-order error (h = 1e-7 s) of co-simulation's */
+        if (a->fmi >= 4) { /* the impact ended, eps within Euler's first-order error (h = 1e-7 s) of co-simulation's */
             const run *cs = &alone[a->variant * PER_VARIANT + a->config];
             const double eps = a->outputs[STEPS - 1][OUTPUTS - 1], cs_eps = cs->outputs[STEPS - 1][OUTPUTS - 1];
             CHECK(eps > 0.0 && fabs(eps / cs_eps - 1.0) < 2e-3, "%s, %s, variant %d: eps %.9g, co-simulation's %.9g",
