@@ -284,6 +284,20 @@ def test_the_derivatives_are_the_dashpot_models(instance):
     assert i.get("event_x1") == x[0] - x[2]
 
 
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_the_driven_scenes_rate_follows_the_inputs_at_once(instance, instance3, fmi):
+    """In the driven scene the approach speed is the input v - v2 (docs/model_exchange.md): an
+    output read right after the host sets v shows it, before any state is set or derivative
+    taken. One subtraction: exact."""
+    i = (instance if fmi == 2 else instance3)(law=2, scene=2, v=0.5, v2=0.1).start()
+    assert i.get("v_striker") == 0.5 - 0.1
+    i.set("v", 0.7)
+    assert i.get("v_striker") == 0.7 - 0.1
+    assert i.get("der(x)") == 0.7 - 0.1
+    i.set("v2", -0.2)
+    assert i.get("v_striker") == 0.7 + 0.2
+
+
 def test_the_springpots_modes_relax_at_their_rates(instance):
     """A mode's rate is x2' - b phi: with the modes all at the same stretch
     and the force gone, each mode's rate differs from the first's by

@@ -271,10 +271,13 @@ static const fmu_variable *nonfinite_output(const fmu_model *fm)
 }
 
 static int model_exchange_variable(fmu_model *fm, unsigned vr, double *value);
+static void me_follow_inputs(fmu_model *fm);
 
 fm_status fm_get_real(fmu_model *fm, unsigned vr, double *value)
 {
     const fmu_variable *var;
+    if (fm->model_exchange)
+        me_follow_inputs(fm); /* the driven scene's rate is the inputs as set, not as last integrated */
     if (model_exchange_variable(fm, vr, value))
         return FM_OK;
     var = fmu_find(&variables, vr, VAR_REAL, &fm->log);
