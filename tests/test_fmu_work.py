@@ -9,17 +9,15 @@ flight is one exact step is no such step: it runs in about a millisecond."""
 import json
 import os
 import pathlib
-import subprocess
-import sys
 import time
 
 import pytest
 
 import fraccontact
+from child_process import child_results
 from conftest import FMU
 
 FMU3 = pathlib.Path(os.environ.get("FRACCONTACT_FMU3", FMU.parent / "fraccontact-fmi3.fmu"))
-TESTS = pathlib.Path(__file__).resolve().parent
 V0 = 0.626418  # the default impact velocity
 OUTPUTS = ["F", "F_peak", "x", "x1", "x2", "v_striker", "E_diss", "eps"]
 LIMIT = "more than 1e+09"
@@ -137,13 +135,8 @@ def child(fmi):
 def refusals(request):
     """The child's results; it is given 60 s for all the cases, which take seconds: any
     step that takes the long way (1e9 internal steps) runs past that."""
-    code = f"import sys; sys.path.insert(0, {str(TESTS)!r}); import test_fmu_work; test_fmu_work.child({request.param})"
-    try:
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    except subprocess.TimeoutExpired:
-        pytest.fail(f"FMI {request.param}: a refused configuration's step did not return within 60 s")
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout.splitlines()[-1])
+    return child_results("test_fmu_work", request.param, 60,
+                         f"FMI {request.param}: a refused configuration's step did not return within 60 s")
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])

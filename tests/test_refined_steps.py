@@ -11,13 +11,11 @@ instead of hanging the suite."""
 
 import json
 import re
-import pathlib
-import subprocess
-import sys
 
 import pytest
 
-TESTS = pathlib.Path(__file__).resolve().parent
+from child_process import child_results
+
 # The fuzzers' two inputs: a driven proxy striker (fuzz-timeout-1) and a drop test (fuzz-timeout-2).
 TINY = [dict(scene=2, m=7.32138302413571e-304, v=1.0674309471292458e-255),
         dict(scene=1, m=8.303894128978216e-275, v=8.4962870852480123e-314)]
@@ -66,14 +64,8 @@ def fmu_child(fmi):
 def run_child(which):
     """The child's results; 60 s for cases that take milliseconds: one that runs its
     steps to the 1e9-step limit (minutes) runs past that."""
-    code = (f"import sys; sys.path.insert(0, {str(TESTS)!r}); import test_refined_steps; "
-            f"test_refined_steps.child({which!r})")
-    try:
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    except subprocess.TimeoutExpired:
-        pytest.fail(f"{which}: a striker whose refined steps cannot stop it was not refused within 60 s")
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout.splitlines()[-1])
+    return child_results("test_refined_steps", which, 60,
+                         f"{which}: a striker whose refined steps cannot stop it was not refused within 60 s")
 
 
 def child(which):

@@ -402,12 +402,17 @@ def instantiated(md, unzipped, fmi, messages):
                     messages.append(message.decode())
         return Probe(md, unzipped, start=False, instance_name="export").fmu
     from fmpy.fmi3 import FMU3Slave
+    return fmi3_instance(FMU3Slave, md.coSimulation, md, unzipped, messages)
 
+
+def fmi3_instance(kind, interface, md, unzipped, messages):
+    """An FMI 3.0 instance (kind: fmpy's FMU3Slave or FMU3Model) of the unpacked FMU's
+    interface whose error messages land in messages."""
     def log(env, status, category, message):
         if status >= 3:
             messages.append(message.decode())
-    fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName="export")
+    fmu = kind(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=interface.modelIdentifier,
+               instanceName="export")
     fmu.instantiate(logMessage=log)
     return fmu
 
@@ -416,14 +421,7 @@ def model_exchange_instance(md, unzipped, fmi, messages):
     """A Model Exchange instance of the unpacked FMU whose error messages land in messages."""
     if fmi == 3:
         from fmpy.fmi3 import FMU3Model
-
-        def log(env, status, category, message):
-            if status >= 3:
-                messages.append(message.decode())
-        fmu = FMU3Model(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.modelExchange.modelIdentifier,
-                        instanceName="export")
-        fmu.instantiate(logMessage=log)
-        return fmu
+        return fmi3_instance(FMU3Model, md.modelExchange, md, unzipped, messages)
     from ctypes import byref
     from fmpy import calloc, free
     from fmpy.fmi2 import (FMU2Model, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
