@@ -126,8 +126,8 @@ static const char *shown_step(const contact_params *p, char text[64])
  * the dashpot has relaxed (in c / k' after the onset) x2 follows the
  * striker and the spring carries c v, at x1^n = c v / k. Where that is
  * below the normal doubles the force is a denormal of few digits, whose
- * rounding the error control takes for error and the fixed steps for
- * separations: the steps collapse and the contact chatters, without end.
+ * rounding the error control takes for error: the steps collapse, and the
+ * contact ends where x1 rounds to 0 with the striker still moving in.
  * A striker arriving at a denormal speed indents by less than a double
  * holds and meets no contact (not this rule's). */
 static int reject_soft_dashpot(const contact_params *p, double v, char *msg, size_t len)
@@ -137,8 +137,8 @@ static int reject_soft_dashpot(const contact_params *p, double v, char *msg, siz
     if (p->damper != CONTACT_DAMPER_DASHPOT || !(v >= DBL_MIN) || !(p->c * v < DBL_MIN * K))
         return 0;
     snprintf(msg, len,
-             "c = %s is invalid with v = %s: the spring would carry the dashpot's force c v at x1^n = c v / k = %s, "
-             "below the smallest normal double (%.3g); raise c above %.3g",
+             "c = %s is invalid for the striker arriving at v = %s: the spring would carry the dashpot's force c v "
+             "at x1^n = c v / k = %s, below the smallest normal double (%.3g); raise c above %.3g, or v",
              shown(p->c, text[0]), shown(v, text[1]), shown(p->c / K * v, text[2]), DBL_MIN, DBL_MIN * K / v);
     return -1;
 }
