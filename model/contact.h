@@ -346,8 +346,9 @@ int contact_arrival_warning(const contact_params *p, double v, char *msg, size_t
  * striker of mass m starting at v (the fastest: CONTACT_RESOLUTION steps
  * while the spring stops the striker), and whether the fixed steps that are
  * refined in contact instead can stop it (their first indentation and force
- * normal numbers). 0, or -1 and a message naming dt_max (or m and v), the
- * values and the rule. */
+ * normal numbers); and that a dashpot's force c v at the arrival speed is
+ * one the spring can carry (c v / k a normal double). 0, or -1 and a
+ * message naming dt_max (or m and v, or c), the values and the rule. */
 int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len);
 
 /* A warning where fixed steps of dt_max do not resolve that impact and are

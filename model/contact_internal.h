@@ -80,6 +80,7 @@ void radau_indentation_polynomial(const contact_state *s, const contact_state *t
 /* control.c */
 double next_step(double h, double error, double least);
 double error_length(contact_model *cm, const contact_state *in, double K, const contact_state *out);
+double error_travel(double length, const contact_state *in, const contact_state *out);
 double error_speed(const contact_state *in, const contact_state *out);
 double onset_step(const contact_model *cm);
 double recovery_step(const contact_model *cm, double remaining);

@@ -63,6 +63,17 @@ double error_length(contact_model *cm, const contact_state *in, double K, const 
     return length;
 }
 
+/* The scale of a step's error in x2: x1's (error_length above), or x2's
+ * travel over the step where that is longer. A dashpot far softer than the
+ * spring lets x2 follow the striker once its fast relaxation (c / k') is
+ * over, on steps far longer than that: x2's error is then the force's
+ * relative error times the travel, and set against the tiny indentation
+ * it would shrink the steps to x1 / v, without end. */
+double error_travel(double length, const contact_state *in, const contact_state *out)
+{
+    return larger(length, fabs(out->x2 - in->x2));
+}
+
 /* The scale of a step's error in v: the speed at onset or now. */
 double error_speed(const contact_state *in, const contact_state *out)
 {

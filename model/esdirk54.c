@@ -30,8 +30,8 @@ static const double esdirk_a[ESDIRK_STAGES][ESDIRK_STAGES] = {
 
 /* One ESDIRK step of length h from *in with spring stiffness K (the
  * contract of sdirk_step), the damper a dashpot. out->error is the
- * embedded estimate of its error over the tolerance: x1's and x2's
- * relative to error_length, v's to error_speed. E_diss is the order-5
+ * embedded estimate of its error over the tolerance: x1's relative to
+ * error_length, x2's to error_travel, v's to error_speed. E_diss is the order-5
  * quadrature of F^2/c (SDIRK2's mean force times the travel is of order 2
  * only). */
 static double esdirk_step(contact_model *cm, const contact_state *in, double h, double K, contact_state *out)
@@ -40,7 +40,7 @@ static double esdirk_step(contact_model *cm, const contact_state *in, double h, 
     damper_stage damper = {0.0, cm->inv_c};
     double F[ESDIRK_STAGES], rise[ESDIRK_STAGES];
     double X = in->x1, V = in->v, X_embedded = 0.0, V_embedded = 0.0, x2_embedded = 0.0;
-    double impulse = 0.0, work = 0.0, error;
+    double impulse = 0.0, work = 0.0, length, error;
     int i, j;
     F[0] = in->F;
     for (i = 0; i <= last; i++) {
@@ -79,7 +79,9 @@ static double esdirk_step(contact_model *cm, const contact_state *in, double h, 
     out->step = h;
     out->x2 = in->x2 + impulse * cm->inv_c;
     out->E_diss = in->E_diss + work * cm->inv_c;
-    error = larger(fabs(X - X_embedded), fabs(impulse - x2_embedded) * cm->inv_c) / error_length(cm, in, K, out);
+    length = error_length(cm, in, K, out);
+    error = larger(fabs(X - X_embedded) / length,
+                   fabs(impulse - x2_embedded) * cm->inv_c / error_travel(length, in, out));
     out->error = larger(error, fabs(V - V_embedded) / error_speed(in, out)) / cm->p.tolerance;
     return impulse;
 }

@@ -1,4 +1,5 @@
 /* Whether fixed steps resolve an impact: the time a striker takes to stop,
+ * the refusal of a dashpot too soft for the spring to carry its force,
  * the uniform grids' check of dt_max against it, the warning where the
  * fixed steps are refined in contact and the refusal where those cannot
  * stop the striker, the fixed step of a contact, and the check that an
@@ -121,11 +122,34 @@ static const char *shown_step(const contact_params *p, char text[64])
     return text;
 }
 
+/* The refusal of a dashpot too soft for the spring to carry its force: once
+ * the dashpot has relaxed (in c / k' after the onset) x2 follows the
+ * striker and the spring carries c v, at x1^n = c v / k. Where that is
+ * below the normal doubles the force is a denormal of few digits, whose
+ * rounding the error control takes for error: the steps collapse, and the
+ * contact ends where x1 rounds to 0 with the striker still moving in.
+ * A striker arriving at a denormal speed indents by less than a double
+ * holds and meets no contact (not this rule's). */
+static int reject_soft_dashpot(const contact_params *p, double v, char *msg, size_t len)
+{
+    const double K = spring_constant(p);
+    char text[3][32];
+    if (p->damper != CONTACT_DAMPER_DASHPOT || !(v >= DBL_MIN) || !(p->c * v < DBL_MIN * K))
+        return 0;
+    snprintf(msg, len,
+             "c = %s is invalid for the striker arriving at v = %s: the spring would carry the dashpot's force c v "
+             "at x1^n = c v / k = %s, below the smallest normal double (%.3g); raise c above %.3g, or v",
+             shown(p->c, text[0]), shown(v, text[1]), shown(p->c / K * v, text[2]), DBL_MIN, DBL_MIN * K / v);
+    return -1;
+}
+
 int contact_check_resolution(const contact_params *p, double v, double m, char *msg, size_t len)
 {
     const double t = first_turnaround(p, v, m);
     const char *grid = method_record(p)->uniform_grid, *fault;
     char text[3][64], why[96];
+    if (reject_soft_dashpot(p, arrival_speed(p, v), msg, len))
+        return -1;
     if (!(t < CONTACT_RESOLUTION * contact_step_limit(p)))
         return 0;
     if (refines_fixed_steps(method_record(p))) {
