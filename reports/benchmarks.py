@@ -206,7 +206,7 @@ FMU_SETTINGS = (("adaptive: tolerance 1e-6, dt_max 1e-3 s", 1e-6, 1e-3, 60),
                 (FMU_FIXED, 0.0, 1e-7, 6))
 PRECISION_BEGIN, PRECISION_END = "<!-- precision: begin -->", "<!-- precision: end -->"
 PRECISION_FIGURE = "benchmarks_work_precision.png"
-ADAPTIVE, FIXED = "ours, adaptive: ESDIRK 5(4), dt_max 1e-3 s", "ours, fixed SDIRK2 steps"
+ADAPTIVE, FIXED = "ours, adaptive: ESDIRK 5(4), dt_max 1e-3 s", "ours, fixed discrete-gradient steps"
 ANCHOR, LSODA = "GSL rk8pd anchor", "scipy LSODA"
 
 
@@ -511,7 +511,7 @@ def precision_section(r):
            "impact has ended and eps, t_contact and x2_end do not exist.",
            "- **Methods**, all on the Hertz spring (law 2) in series with the dashpot: ours with error-controlled "
            f"steps (`--tolerance T --dt-max {ADAPTIVE_DT_MAX:g}`, Kvaerno's L-stable ESDIRK 5(4)) at T = 1e-3, "
-           "3e-4, ... 1e-10; ours with fixed SDIRK2 steps (`--dt-max DT`, "
+           "3e-4, ... 1e-10; ours with fixed discrete-gradient steps (`--dt-max DT`, docs/model.md §11, "
            f"tolerance 0) at DT = 1e-5 s / 2^i, i = 0..{len(FIXED_STEPS) - 1}; the GSL rk8pd anchor "
            "(`fraccontact-bench anchor K C M V T_END RTOL`: adaptive rk8pd, the peak and the separation located by "
            "secant iterations, as a competent user scripts an impact) and scipy's `solve_ivp` LSODA, DOP853 and "
