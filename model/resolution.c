@@ -255,9 +255,13 @@ int contact_check_work(const contact_model *cm, double H, double max_steps, char
     if (v >= 0.0)
         step = cm->s.in_contact ? cm->contact_step : contact_step_at(cm, v);
     if (step < cm->h_max) {
+        /* the clock the refined steps must advance: the contact's, from its
+         * onset over the steps of its load and release (CONTACT_REFINED
+         * each), as far as this advance goes */
         const double rate = cm->s.in_contact ? cm->s.v : v;
-        const char *fault = refined_fault(&cm->p, cm->k, fmax(cm->s.x1, 0.0), rate, cm->accel, step, cm->s.t + H,
-                                          why);
+        const double onset = cm->s.t + (cm->s.in_contact ? 0.0 : flight_onset(cm->s.x1, cm->s.v, cm->accel, H));
+        const double last = fmin(cm->s.t + H, onset + 2.0 * CONTACT_REFINED * step);
+        const char *fault = refined_fault(&cm->p, cm->k, fmax(cm->s.x1, 0.0), rate, cm->accel, step, last, why);
         if (fault) {
             snprintf(from, sizeof from, " for this advance from t = %.17g s", cm->s.t);
             return reject_refined(1.0 / cm->inv_m, v, step, from, fault, msg, len);

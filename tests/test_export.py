@@ -512,11 +512,12 @@ def test_the_pages_model_exchange_command_does_what_it_says(tmp_path):
     assert read_model_description(str(tmp_path / "pp_me.fmu")).modelExchange is not None
 
 
-def test_the_pages_specialized_build_section_follows_from_its_figures():
+def test_the_pages_specialized_build_section_follows_from_its_figures(monkeypatch):
     """The report's figures on the page give its ratio and its decision by
     docs/benchmarks.md's rule, and its edits still apply to the sources (so
     that scripts/report specialized measures it again)."""
     sys.path.insert(0, str(ROOT))
+    monkeypatch.chdir(ROOT)  # a source-tree report works in the repository's root (ctest runs pytest elsewhere)
     from reports import specialized
     text = " ".join(PAGE.split(specialized.BEGIN)[1].split(specialized.END)[0].split())
     mine, general, ratio = re.search(r"executes ([\d,]+) instructions per run .*? against the general build's "

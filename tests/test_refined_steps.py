@@ -23,7 +23,7 @@ UNDERFLOW = "below the normal doubles: never stopping it; raise m or v"
 # m = 1e-14 kg at the default v: stopped in about 1.2e-9 s, refined steps of about 3e-13 s, shorter
 # than four ulp of t = 6080 s (5.4e-12 s) but representable at t = 0.
 LIGHT = dict(scene=2, m=1e-14)
-CLOCK = "which do not advance the clock at t = 6080.0001"
+CLOCK = "which do not advance the clock at t = 6080.0000000"  # in the contact that begins at 6080 s
 
 
 def library_child():
