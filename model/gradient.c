@@ -60,7 +60,10 @@ static double secant_force(double K, double n, double x1, double X)
  * relaxation, z <= 2, and just enough beyond to keep the elastic
  * indentation from overshooting its relaxed value (the linear relaxation's
  * factor (1 - z (1 - theta)/2)/(1 + z (1 + theta)/2) is then 0), where the
- * discrete gradient would let it ring from step to step. */
+ * discrete gradient would let it ring from step to step. A springpot
+ * relaxes the spring through the viscous part of its step resistance
+ * alone: its elastic part splits the motion with the spring instead, a
+ * split the blend would only make first order (gradient_step_of). */
 typedef struct {
     double F, S, F_end; /* the step's force, the discrete gradient, the spring's force at X */
     double theta;
@@ -189,9 +192,10 @@ static HOT_INLINE int hertz_mean_force(double K, double theta, double x1, double
 
 /* The step's force *f and its end X, the root of X - x1 + b F(X) = rho:
  * 1, or 0 where common_only and the step is not a common one, free flight
- * or the Hertz sphere's in contact from a good start (nothing written then). */
+ * or the Hertz sphere's in contact from a good start (nothing written then).
+ * theta is at least theta_min. */
 static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv_B, double x1, double rho, double b,
-                                 double *X, step_force *out, const int common_only)
+                                 double *X, step_force *out, const int common_only, const double theta_min)
 {
     const double n = cm->p.spring_exponent;
     step_force f = {0.0, 0.0, 0.0, 0.0};
@@ -206,7 +210,7 @@ static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv
     }
     if (n == 1.5 && x1 >= 0.0) {
         s0 = sqrt(x1);
-        f.theta = theta = relaxation_weight(h_inv_B, 1.5 * K * s0);
+        f.theta = theta = larger(relaxation_weight(h_inv_B, 1.5 * K * s0), theta_min);
         root = theta > 0.0 ? hertz_mean_force(K, theta, x1, s0, rho, b, X, &f, !common_only)
                            : hertz_mean_force(K, 0.0, x1, s0, rho, b, X, &f, !common_only);
         if (root > 0)
@@ -215,6 +219,7 @@ static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv
             return root > 0;
     }
     f.theta = theta = x1 > 0.0 || n == 1.0 ? relaxation_weight(h_inv_B, n * K * pow(larger(x1, 0.0), n - 1.0)) : 0.0;
+    f.theta = theta = larger(theta, theta_min);
     if (n == 1.0 && x1 >= 0.0) { /* a linear spring: F = K (X (1 + theta) + x1 (1 - theta))/2 while X >= 0 */
         *X = (x1 + rho - 0.5 * b * K * (1.0 - theta) * x1) / (1.0 + 0.5 * b * K * (1.0 + theta));
         if (*X >= 0.0) {
@@ -251,6 +256,7 @@ static HOT_INLINE int mean_force(const contact_model *cm, double K, double h_inv
 static const contact_modes *modes_for_step(contact_model *cm, double h)
 {
     contact_modes *m = &cm->modes;
+    double sum_lag = 0.0;
     size_t i;
     if (m->h == h)
         return m;
@@ -262,12 +268,17 @@ static const contact_modes *modes_for_step(contact_model *cm, double h)
         const double d = 1.0 / (1.0 + 0.5 * beta);
         m->p[i] = m->a[i] * mu * d;
         m->sum_q += m->p[i] * mu + 2.0 * m->a[i] * lag;
+        sum_lag += m->a[i] * lag;
         /* phi_new = keep phi + rate z over the step */
         m->keep[i] = (1.0 - 0.5 * beta) * d;
         m->rate[i] = mu * h * d;
         m->q[i] = m->a[i] * m->keep[i];
         m->sum_rate += m->a[i] * m->rate[i];
     }
+    /* of the step resistance c_alpha (eta + h sum_q/2), the part that
+     * dissipates: the lumped dashpot and the modes' viscous pull
+     * c_alpha a_i (1 - mu_i) z/b_i (the rest pulls through their springs) */
+    cm->viscous_share = (float)((m->eta + h * sum_lag) / (m->eta + 0.5 * h * m->sum_q));
     m->h = h;
     return m;
 }
@@ -309,6 +320,23 @@ void advance_modes(contact_model *cm, double h, double z)
         cm->modes.phi[i] = m->keep[i] * m->phi[i] + m->rate[i] * z;
 }
 
+/* The compressed springpot's blend on a contact's first step, from x1 <= 0
+ * towards X_free (the end without the force, above the step's): where the
+ * springpot's springs take part of the motion, theta = (n - 1)/(2n) makes
+ * the mean force from x1 = 0 the mean of the end forces, K X^n/2. With the
+ * secant's K X^n/(n + 1) the motion's split between the two springs would
+ * start off balance by a part of the force, and where the springpot is
+ * nearly a spring nothing damps that split's step-to-step mode. Weighted
+ * by the springpot's elastic share of its resistance and by the share of
+ * the motion its springs take, kappa/(kappa + s), kappa the spring's
+ * stiffness at X_free and s = 2 (elastic resistance)/h its springs'. */
+static COLD double onset_weight(const contact_model *cm, double K, double X_free, double h_inv_B)
+{
+    const double n = cm->p.spring_exponent, elastic = 1.0 - cm->viscous_share;
+    const double kappa = X_free > 0.0 ? n * K * pow(X_free, n - 1.0) : 0.0, s = 2.0 * elastic / h_inv_B;
+    return kappa > 0.0 ? (0.5 - 0.5 / n) * elastic * kappa / (kappa + s) : 0.0;
+}
+
 /* One step of length h from *in with spring stiffness K (0: no contact:
  * free flight, exact while the damper rests). Writes t, x1, x2, v, F,
  * E_diss, the damper's rate and what accepting a springpot's step needs
@@ -327,9 +355,13 @@ static inline int gradient_step_of(contact_model *cm, const contact_state *in, d
      * where there is one (0 * inv_B is not 0 to the compiler) */
     const double coast = in->v + 0.5 * h * cm->accel;
     const double b = h * (d.inv_B + 0.5 * h * cm->inv_m), rho = h * (compressed ? coast + d.A * d.inv_B : coast);
+    /* the compressed springpot relaxes the spring through the viscous part
+     * of its resistance alone (mean_force) */
+    const double h_inv_B = compressed ? h * d.inv_B * cm->viscous_share : h * d.inv_B;
+    const double theta_min = compressed && !(in->x1 > 0.0) ? onset_weight(cm, K, in->x1 + rho, h * d.inv_B) : 0.0;
     double X, z;
     step_force f;
-    if (!mean_force(cm, K, h * d.inv_B, in->x1, rho, b, &X, &f, common_only))
+    if (!mean_force(cm, K, h_inv_B, in->x1, rho, b, &X, &f, common_only, theta_min))
         return 0;
     z = (f.F - d.A) * d.inv_B;
     carry_state(out, in);

@@ -5,32 +5,12 @@ import math
 
 from .core import RESOLVED, check_table
 from .springpot import (AGREE, CHECKS, DEFECTS, FAST, FAST_CONVERGENCE, K1, K2, KE, KNOWN, MEMORY1_STEPS, QUANTITIES,
-                        REF_MEMORY1, REF_MEMORY2, BLEND, expected)
+                        REF_MEMORY1, REF_MEMORY2, expected)
 
 # The line that opens the springpot's part of docs/stability.md.
 HEADING = "\n# The springpot (damper = 2)\n"
 # Why the runs listed in springpot.KNOWN and DEFECTS fail.
-FINDINGS = {
-    BLEND:
-        "The compressed memory's fixed step (model/gradient.c, docs/model.md §11) blends the discrete gradient "
-        "with the spring's force at the step's end by theta = max(0, 1 - 2/z), z the step's relaxation (the "
-        "spring's stiffness times the damper's step compliance): where z > 2 the step is first order. A "
-        "dashpot's z falls as h; a springpot's step compliance only as h^alpha, so at alpha = 0.05 with "
-        "c_alpha x 0.01 (a springpot soft beside the Hertz spring) z stays above 2 at any practical step and "
-        "every figure of memory 2 converges at the order 1: against memory 1 (whose eps moves by less than "
-        "1e-9 from dt = t_c/4000 to t_c/16000), memory 2's eps errs by -2.8e-6, -1.3e-6, -6.8e-7, -3.4e-7, "
-        "-1.7e-7, -8.4e-8 at dt = t_c/6000, /12288, ... /192000 (E_diss by 3.0e-5 ... 9.1e-7 relative), "
-        "while memory 2 with error-controlled steps (tolerance = 1e-8) agrees with memory 1 to 1.5e-11. "
-        "The memories' agreement fails on eps here: memory 2's error at dt_max = 1e-7 (1.2e-6) is above "
-        "K2 (h^2 + lambda) and the kernel's tolerance. The blend cannot simply be left out for the springpot: "
-        "with theta = 0 memory 2 is second order here, but where the springpot is nearly a spring the split "
-        "of the motion between the two springs is algebraic and the discrete gradient leaves its "
-        "step-to-step mode undamped (the trapezoidal rule's factor -1), which the first step of a contact "
-        "excites (its secant K X^n/(n + 1), not the mean of the end forces), so the force alternates from "
-        "step to step; and across a soft, dashpot-like springpot's stiff relaxation it alternates by its "
-        "full size. Open: a blend that damps that mode and vanishes with the step where the motion is "
-        "smooth.",
-}
+FINDINGS = {}
 # Non-failing: the compressed memory's order (built into springpot.K2's form).
 ORDER_FINDING = (
     "**The compressed memory converges at the order 2 - alpha, not 2**, where its kernel's lumped part "
@@ -69,7 +49,7 @@ def separation_note(study):
             "constant moving with the separation's place in the step. It takes the separation where x (linear "
             "between the grid points: its curvature is the force's, near 0) less x2 continued from the "
             "contact's side (the parabola through the last three grid points in contact) is 0, and x2_end from "
-            "that parabola (docs/model.md §7). The study's constants over h^2 (and orders): at n = 1, "
+            "that parabola (docs/model.md §7). The study's constants over h^p (and orders): at n = 1, "
             f"alpha 0.05 {cells('n = 1, alpha 0.05', 1)}; at n = 1.5, alpha 0.05 {cells('alpha 0.05', 1)}, "
             "where the force ~ (t_s - t)^n makes the solution itself only as smooth as (t_s - t)^(n + alpha) "
             "at the separation: the errors fall as h^(n + alpha) times a factor that moves with the "
@@ -126,8 +106,10 @@ def section(study, rows, elapsed):
            f"KE (dt/t_c)^2 of the largest energy in the run, at every row, KE = {KE[1]:g} (memory 1), "
            f"{KE[2]:g} (memory 2);",
            "- **memories agree**: the two runs end the same number of impacts the same way, and every figure "
-           "differs by at most K1 h1^2 + K2 (h2^2 + lambda) + the kernel's tolerance + rounding, h1, h2 each "
-           "memory's dt_max/t_c, lambda = mu/t_c^(2 - alpha) the lumped kernel's lost first moment (finding "
+           "differs by at most K1 h1^p + K2 (h2^2 + lambda) + the kernel's tolerance + rounding, h1, h2 each "
+           "memory's dt_max/t_c, p = 2 but p = min(2, n + alpha) for memory 1's t_contact and x2_end (it takes "
+           "them at its separation, where the solution is only as smooth as (t_s - t)^(n + alpha): finding "
+           "below), lambda = mu/t_c^(2 - alpha) the lumped kernel's lost first moment (finding "
            "below), times t_end/t_c for the figures at t_end (x2, v, E_end: an oscillation's phase error grows "
            "with the time); F_peak, E_diss and E_end only where memory 1's step resolves the force's rise, "
            "dt <= t_F/20, t_F = min(t_c, t_q), t_q the time at which the springpot driven at v with a rigid "
@@ -145,7 +127,7 @@ def section(study, rows, elapsed):
            f"against a reference: memory 1 at t_c/{REF_MEMORY1} where that takes at most 6e4 steps, else "
            f"memory 2 at t_c/{REF_MEMORY2} with its kernel to 1e-10; its own error is its distance to the same "
            "run at twice the step. Each cell is the largest of (error - the reference's error - rounding [- the "
-           "kernel's tolerance, memory 2]) over h^2 (memory 1) or h^2 + lambda (memory 2), times t_c/t_end at "
+           "kernel's tolerance, memory 2]) over h^p (memory 1) or h^2 + lambda (memory 2), times t_c/t_end at "
            "t_end, and the order of the finest pair whose errors stand 100 times above that floor. Identity: "
            "the largest residual over h^2. Fails if a constant exceeds K1, K2 or KE.", "",
            "| regime | memory | " + " | ".join(QUANTITIES) + " | identity | result |",
