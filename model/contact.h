@@ -204,8 +204,9 @@ typedef struct {
     double contact_step;    /* the fixed step in the current contact: h_max, or shorter to resolve it */
     int64_t max_steps;      /* the most internal steps one advance may take; 0: no limit */
     int exceeded;           /* set by an advance that fails: whether it stopped at max_steps */
-    float viscous_share;    /* modes.h's too (gradient.c's blend): the viscous part of the springpot's step
-                               resistance; a float, in the padding before modes, so that the model keeps its size */
+    float viscous_share;    /* for the step length modes.h (gradient.c's blend): the viscous part of the
+                               springpot's step resistance; a float, in the padding before modes, so that the
+                               model keeps its size */
     contact_modes modes;      /* a springpot's compressed memory (owned: contact_release) */
     contact_history history;  /* a springpot's full G1 history (owned: contact_release) */
 } contact_model;
